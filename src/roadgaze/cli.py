@@ -1,6 +1,7 @@
 """The `roadgaze` command: a thin argparse layer over the typed functions of each stage.
 
-Each sub-command lives in `roadgaze.commands.<name>` and registers itself with `register()`;
+Each sub-command lives in a module of `roadgaze.commands`, found automatically, that registers
+itself with `register(subparsers)` (and may set `ORDER`, an int, for its place in `--help`);
 heavy imports (MediaPipe, Zenoh, OpenCV) happen inside the handlers so `roadgaze --help` is fast.
 A `RoadgazeError` ends in one line on stderr and its exit code, never a traceback.
 """
@@ -10,15 +11,24 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import pkgutil
 import sys
 from collections.abc import Sequence
+from types import ModuleType
 
-from roadgaze import __version__
+from roadgaze import __version__, commands
 from roadgaze.errors import RoadgazeError
 from roadgaze.logs import setup_logging
 
-COMMAND_MODULES = ("paper",)
-"""Sub-command modules under roadgaze.commands, in the order `--help` lists them."""
+
+def _command_modules() -> list[ModuleType]:
+    """Every module in roadgaze.commands, ordered by its ORDER (then name) for `--help`."""
+    modules = [
+        importlib.import_module(f"{commands.__name__}.{info.name}")
+        for info in pkgutil.iter_modules(commands.__path__)
+    ]
+    return sorted(modules, key=lambda module: (getattr(module, "ORDER", 100), module.__name__))
+
 
 log = logging.getLogger("roadgaze")
 
@@ -30,8 +40,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"roadgaze {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in COMMAND_MODULES:
-        importlib.import_module(f"roadgaze.commands.{name}").register(subparsers)
+    for module in _command_modules():
+        module.register(subparsers)
     return parser
 
 

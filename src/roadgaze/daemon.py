@@ -1,0 +1,240 @@
+"""The `run` service: frames -> yaw samples -> monitor -> Zenoh, until a signal or the end.
+
+`MonitorPublisher` is the sample sink shared by `roadgaze run` and `roadgaze replay --publish`:
+it steps the monitor on each sample, publishes the yaw message and every alert, keeps the
+counters and answers the state query. `run_daemon` wires it to a frame source, retries a lost
+camera with backoff, and on SIGINT/SIGTERM finishes the current frame, publishes a final state,
+undeclares everything and returns 0.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from typing import Any, Literal, Protocol
+
+from roadgaze.config import Config
+from roadgaze.monitor import Alert, AlertKind, Monitor
+from roadgaze.transport import (
+    AlertMessage,
+    Keys,
+    MonitorSnapshot,
+    SpeedInput,
+    StateMessage,
+    TransportStatus,
+    YawMessage,
+)
+from roadgaze.types import YawSample
+
+log = logging.getLogger("roadgaze.daemon")
+
+Status = Literal["starting", "running", "degraded", "stopping", "stopped"]
+
+
+class MessageLink(Protocol):
+    """Where messages go: `transport.ZenohLink` in production, a list in tests."""
+
+    speed: SpeedInput | None
+
+    def publish_yaw(self, message: YawMessage) -> None: ...
+
+    def publish_alert(self, message: AlertMessage) -> None: ...
+
+    def status(self) -> TransportStatus: ...
+
+
+class MonitorPublisher:
+    """Sample sink: monitor + publisher + counters; thread-safe `state_json` for the queryable."""
+
+    def __init__(
+        self,
+        config: Config,
+        keys: Keys,
+        link: MessageLink | None,
+        source_label: str,
+        wall_clock: Callable[[], float] = time.time,
+    ) -> None:
+        self.config = config
+        self.keys = keys
+        self.link = link
+        self.source_label = source_label
+        self.monitor = Monitor(config.monitor)
+        self._wall_clock = wall_clock
+        self._started = time.monotonic()
+        self.status: Status = "starting"
+        self.source_status = "opening"
+        self.problems: list[str] = []
+        self.frames = 0
+        self.faces = 0
+        self.camera_reopens = 0
+        self._yaw_seq = 0
+        self._alert_seq = 0
+        self.alerts: list[Alert] = []
+        """Every alert raised, in order (bounded by what one run can raise: a few per glance)."""
+        self.last_extras: dict[str, Any] = {}
+        """The monitor's view of the last sample, for frame records (JSONL extras)."""
+
+    def _speed(self) -> tuple[float | None, Literal["none", "waiting", "fresh", "stale"]]:
+        speed = None if self.link is None else self.link.speed
+        if speed is None:
+            return None, "none"
+        return speed.current()
+
+    def on_sample(self, sample: YawSample) -> tuple[Alert, ...]:
+        speed_kmh, _ = self._speed()
+        alerts = self.monitor.update(sample, speed_kmh)
+        state = self.monitor.state
+        self.frames += 1
+        self.faces += int(sample.face)
+        if self.status == "starting":
+            self.status = "running"
+        on_road = None if state.gaze.value == "unknown" else state.on_road
+        window_s = self.config.monitor.vats_window_s
+        self.last_extras = {
+            "on_road": on_road,
+            "gaze": state.gaze.value,
+            "neutral_yaw_deg": round(state.neutral_yaw_deg, 3),
+            "off_road_s": round(state.off_road_s(), 3),
+            "window_off_road_s": round(state.window_off_road_s(window_s), 3),
+            "alerts": [f"{a.kind.value}:{a.level.value}" for a in alerts],
+        }
+        wall_time = self._wall_clock()
+        if self.link is not None:
+            self.link.publish_yaw(
+                YawMessage(
+                    vehicle_id=self.keys.vehicle_id,
+                    seq=self._yaw_seq,
+                    t_s=sample.t_s,
+                    wall_time=wall_time,
+                    frame=sample.frame,
+                    face=sample.face,
+                    yaw_deg=sample.yaw_deg,
+                    yaw_raw_deg=sample.yaw_raw_deg,
+                    yaw_rate_dps=sample.yaw_rate_dps,
+                    on_road=on_road,
+                    gaze=state.gaze.value,
+                    neutral_yaw_deg=state.neutral_yaw_deg,
+                    n_faces=sample.n_faces,
+                )
+            )
+        self._yaw_seq += 1
+        for alert in alerts:
+            self._publish_alert(alert, wall_time)
+        return alerts
+
+    def _publish_alert(self, alert: Alert, wall_time: float) -> None:
+        self.alerts.append(alert)
+        message = alert_message(alert, self.keys.vehicle_id, self._alert_seq, wall_time)
+        self._alert_seq += 1
+        log.info(
+            "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)",
+            alert.kind.value,
+            alert.level.value,
+            alert.t_s,
+            alert.off_road_s,
+            alert.window_off_road_s,
+            extra={"alert": message.model_dump(by_alias=True)},
+        )
+        if self.link is not None:
+            self.link.publish_alert(message)
+
+    def state_message(self) -> StateMessage:
+        """The current state; safe to call from Zenoh's callback thread."""
+        state = self.monitor.state  # immutable: one consistent snapshot
+        speed_kmh, speed_source = self._speed()
+        transport = (
+            self.link.status()
+            if self.link is not None
+            else TransportStatus(mode=self.config.zenoh.mode, session_open=False, connected=False)
+        )
+        problems = list(self.problems)
+        if self.link is not None and not transport.connected:
+            problems.append("zenoh not connected")
+        status = self.status
+        if status == "running" and problems:
+            status = "degraded"
+        monitor = self.config.monitor
+        return StateMessage(
+            vehicle_id=self.keys.vehicle_id,
+            wall_time=self._wall_clock(),
+            status=status,
+            problems=problems,
+            t_s=state.t_s,
+            uptime_s=time.monotonic() - self._started,
+            source=self.source_label,
+            source_status=self.source_status,
+            frames=self.frames,
+            faces=self.faces,
+            camera_reopens=self.camera_reopens,
+            transport=transport,
+            monitor=MonitorSnapshot(
+                gaze=state.gaze.value,
+                on_road=state.on_road,
+                neutral_yaw_deg=state.neutral_yaw_deg,
+                yaw_deg=state.yaw_deg,
+                off_road_s=state.off_road_s(),
+                window_off_road_s=state.window_off_road_s(monitor.vats_window_s),
+                unavailable_s=state.unavailable_s(),
+                vats_armed=state.vats_armed,
+                active_alerts=[kind.value for kind in state.active],
+                moving=state.moving,
+                speed_kmh=speed_kmh,
+                speed_source=speed_source,
+                alert_counts=dict(state.alert_counts),
+            ),
+            config={
+                "monitor": monitor.model_dump(mode="json"),
+                "keys": {
+                    "yaw": self.keys.yaw,
+                    "alert": self.keys.alert,
+                    "alive": self.keys.alive,
+                    "state": self.keys.state,
+                    "speed": self.keys.speed,
+                },
+                "zenoh_mode": self.config.zenoh.mode,
+            },
+        )
+
+    def state_json(self) -> bytes:
+        return self.state_message().to_json_bytes()
+
+    def close(self) -> None:
+        """Nothing to release: the link is owned by whoever opened it."""
+
+
+def alert_message(alert: Alert, vehicle_id: str, seq: int, wall_time: float) -> AlertMessage:
+    """The wire form of one monitor alert."""
+    return AlertMessage(
+        vehicle_id=vehicle_id,
+        seq=seq,
+        kind=alert.kind.value,
+        level=alert.level.value,
+        t_s=alert.t_s,
+        wall_time=wall_time,
+        yaw_deg=alert.yaw_deg,
+        off_road_s=max(0.0, alert.off_road_s),
+        window_off_road_s=max(0.0, alert.window_off_road_s),
+        unavailable_s=max(0.0, alert.unavailable_s),
+        speed_kmh=alert.speed_kmh,
+        clears=[kind.value for kind in alert.clears if kind is not AlertKind.CLEARED],
+    )
+
+
+class StopFlag:
+    """Set by SIGINT/SIGTERM; the loop checks it between frames."""
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+        self.signal_name: str | None = None
+
+    def set(self, name: str = "request") -> None:
+        self.signal_name = name
+        self._event.set()
+
+    def is_set(self) -> bool:
+        return self._event.is_set()
+
+    def wait(self, timeout_s: float) -> bool:
+        return self._event.wait(timeout_s)

@@ -45,6 +45,8 @@ ALERT_SCHEMA = "roadgaze.alert/1"
 STATE_SCHEMA = "roadgaze.state/1"
 PENDING_ALERTS_MAX = 256
 """Alerts kept while no session is open; the oldest are dropped (and counted) beyond this."""
+PENDING_FLUSH_WAIT_S = 2.0
+"""After a session (re)opens, how long kept alerts wait for a matching subscriber."""
 
 
 class _Message(BaseModel):
@@ -434,18 +436,26 @@ class ZenohLink:
             self.last_error = str(exc).split(" at /")[0]
             log.warning("zenoh session not available (%s); monitoring goes on", self.last_error)
             return False
-        with self._lock:
-            if self._stop.is_set():
-                declared.close()
-                return True
-            self._declared = declared
-            pending = list(self._pending)
-            self._pending.clear()
         self.last_error = None
         log.info("zenoh session open (%s), prefix %s", self.config.mode, self.keys.prefix)
-        for payload in pending:
-            self._put_alert(payload)
-        return True
+        if self._pending:
+            # Give subscribers a moment to be matched, so kept alerts reach somebody.
+            deadline = time.monotonic() + PENDING_FLUSH_WAIT_S
+            while not declared.alert.matching_status.matching and time.monotonic() < deadline:
+                if self._stop.wait(0.05):
+                    break
+        while True:
+            with self._lock:
+                if self._stop.is_set():
+                    declared.close()
+                    return True
+                pending = list(self._pending)
+                self._pending.clear()
+                if not pending:
+                    self._declared = declared
+                    return True
+            for payload in pending:
+                self._put(declared, payload)
 
     def _reopen_loop(self) -> None:
         delay_s = self.config.reconnect_initial_s
@@ -485,6 +495,9 @@ class ZenohLink:
             if declared is None:
                 self._pending.append(payload)
                 return
+        self._put(declared, payload)
+
+    def _put(self, declared: _Declared, payload: bytes) -> None:
         try:
             declared.alert.put(payload)
             self.alerts_sent += 1

@@ -75,7 +75,7 @@ class SmoothingConfig(_Section):
 
     measurement_std_deg: float = Field(default=3.0, gt=0)
     """Standard deviation of one raw Center-CE measurement."""
-    acceleration_std_dps2: float = Field(default=400.0, gt=0)
+    acceleration_std_dps2: float = Field(default=200.0, gt=0)
     """White-noise yaw acceleration driving the constant-velocity model."""
     gate_sigma: float = Field(default=4.0, gt=0)
     """Reject a measurement whose innovation exceeds this many standard deviations."""
@@ -83,7 +83,7 @@ class SmoothingConfig(_Section):
     """After this many consecutive rejections, the track is re-initialised on the measurement."""
     reinit_gap_s: float = Field(default=1.5, gt=0)
     """After this long without a face the track is dropped and restarts on the next face."""
-    initial_std_deg: float = Field(default=10.0, gt=0)
+    initial_std_deg: float = Field(default=3.0, gt=0)
     initial_rate_std_dps: float = Field(default=60.0, gt=0)
 
 

@@ -4,9 +4,10 @@
 three inputs of the yaw models (see PAPER.md): the eye line (outer corners 33 and 263) gives the
 roll; the landmarks are rotated about the eye midpoint so that the eye line is horizontal; then
 
-- the left and right boundaries are the extreme x of the face-oval landmarks lying between eye
-  height and mouth height (`BOUNDARY_BAND`), and
-- the centre is the mean x of the nose-midline landmarks `CENTER_LANDMARKS`,
+- the left and right boundaries are the extreme x of all mesh landmarks (the silhouette of the
+  projected mesh) in a horizontal band from 0.1 to 0.5 of the eye-to-mouth distance below the eye
+  line (cheek height, below the eyes and above the mouth), and
+- the centre is the mean x of the nose tip (1) and the point just above it on the ridge (4),
 
 a choice measured on Pointing'04 subjects 1-10 against the alternatives (docs/landmarks.md).
 `MediaPipeLandmarker` runs the model (IMAGE mode for stills, VIDEO mode for streams) and chooses
@@ -65,12 +66,38 @@ class LandmarkChoice:
 
 
 DEFAULT_CHOICE = LandmarkChoice(
-    name="mesh silhouette, band [0.1, 0.4] / nose tip",
-    center_landmarks=(NOSE_TIP,),
+    name="mesh silhouette in band [0.1, 0.5] / nose 1+4",
+    center_landmarks=(NOSE_TIP, 4),
     boundary_landmarks=None,
-    boundary_band=(0.1, 0.4),
+    boundary_band=(0.1, 0.5),
 )
 """The measured best choice on Pointing'04 subjects 1-10 together (docs/landmarks.md)."""
+
+
+_MIDLINE = (168, 6, 197, 195, 5, 4, 1)
+CANDIDATE_CHOICES: tuple[LandmarkChoice, ...] = (
+    LandmarkChoice("face oval, extreme x / nose tip 1", (NOSE_TIP,), FACE_OVAL),
+    LandmarkChoice("face oval, extreme x / nose bridge 168", (168,), FACE_OVAL),
+    LandmarkChoice("face oval, extreme x / nose bridge 6", (6,), FACE_OVAL),
+    LandmarkChoice("face oval, extreme x / midline mean", _MIDLINE, FACE_OVAL),
+    LandmarkChoice("cheeks 234/454 / nose tip 1", (NOSE_TIP,), (234, 454)),
+    LandmarkChoice("cheeks 234/454 / nose bridge 168", (168,), (234, 454)),
+    LandmarkChoice("temples 127/356 / nose tip 1", (NOSE_TIP,), (127, 356)),
+    LandmarkChoice("temples 127/356 / nose bridge 6", (6,), (127, 356)),
+    LandmarkChoice("cheeks 93/323 / nose tip 1", (NOSE_TIP,), (93, 323)),
+    LandmarkChoice("face oval in band [0, 1] / nose 1+4", (NOSE_TIP, 4), FACE_OVAL, (0.0, 1.0)),
+    LandmarkChoice("mesh silhouette, whole face / nose tip 1", (NOSE_TIP,)),
+    LandmarkChoice("mesh silhouette in band [0, 1] / nose 1+4", (NOSE_TIP, 4), None, (0.0, 1.0)),
+    LandmarkChoice(
+        "mesh silhouette in band [0.1, 0.5] / nose tip 1", (NOSE_TIP,), None, (0.1, 0.5)
+    ),
+    LandmarkChoice(
+        "mesh silhouette in band [0.1, 0.5] / nose bridge 168", (168,), None, (0.1, 0.5)
+    ),
+    LandmarkChoice("mesh silhouette in band [0.1, 0.5] / midline mean", _MIDLINE, None, (0.1, 0.5)),
+    DEFAULT_CHOICE,
+)
+"""The alternatives compared in docs/landmarks.md (`roadgaze eval --compare-landmarks`)."""
 
 
 def roll_from_eyes_deg(landmarks_px: npt.NDArray[np.floating[Any]]) -> float:

@@ -75,6 +75,22 @@ class ModelSource(Protocol):
 
 
 @dataclass(frozen=True, slots=True)
+class LocalFileSource:
+    """A model file already on disk (the explicit path, when `model fetch` copies it)."""
+
+    path: Path
+
+    @property
+    def description(self) -> str:
+        return f"explicit path {self.path}"
+
+    def fetch(self, timeout_s: float) -> bytes:
+        if not self.path.is_file():
+            raise ModelError("not found")
+        return self.path.read_bytes()
+
+
+@dataclass(frozen=True, slots=True)
 class UrlSource:
     """An HTTP(S) URL serving the model file itself."""
 
@@ -209,6 +225,7 @@ def write_atomically(path: Path, data: bytes) -> None:
             stream.write(data)
             stream.flush()
             os.fsync(stream.fileno())
+        Path(temporary).chmod(0o644)
         Path(temporary).replace(path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
@@ -224,47 +241,78 @@ def _manual_hint(cache_file: Path, expected: ExpectedFile) -> str:
     )
 
 
+def _download(
+    cache_file: Path,
+    sources: Sequence[ModelSource],
+    timeout_s: float,
+    expected: ExpectedFile,
+    tried: list[str],
+) -> Path | None:
+    """Write the first verified source's bytes to `cache_file`; None (and `tried`) when all fail."""
+    for source in sources:
+        log.info("fetching the face landmarker model from %s", source.description)
+        try:
+            data = source.fetch(timeout_s)
+        except (OSError, ModelError, subprocess.SubprocessError, ValueError) as exc:
+            reason = str(exc) or type(exc).__name__
+            log.warning("model source %s failed: %s", source.description, reason)
+            tried.append(f"{source.description}: {reason}")
+            continue
+        problem = check_bytes(data, expected)
+        if problem is not None:
+            log.warning("model from %s rejected: %s", source.description, problem)
+            tried.append(f"{source.description}: rejected, {problem}")
+            continue
+        try:
+            write_atomically(cache_file, data)
+        except OSError as exc:
+            tried.append(f"writing {cache_file}: {exc.strerror or exc}")
+            break
+        log.info("face landmarker model saved to %s", cache_file)
+        return cache_file
+    return None
+
+
+def _unavailable(cache_file: Path, expected: ExpectedFile, tried: list[str]) -> ModelError:
+    return ModelError(
+        "face landmarker model unavailable; tried "
+        + "; ".join(tried)
+        + ". "
+        + _manual_hint(cache_file, expected)
+    )
+
+
 def fetch_model(
     config: ModelConfig,
     *,
     sources: Sequence[ModelSource] = DEFAULT_SOURCES,
     environ: Mapping[str, str] | None = None,
     expected: ExpectedFile = MODEL_FILE,
-    tried: list[str] | None = None,
+    force: bool = False,
 ) -> Path:
-    """Download the model into the cache from the first source that gives verified bytes.
+    """Put a verified model in the cache and return its path (`roadgaze model fetch`).
 
-    Ignores `allow_download` (this is the explicit fetch); raises `ModelError` when all fail.
+    Tries, in order: the explicit path (copied into the cache when valid), the cache itself (kept
+    when valid, unless `force`), then `sources`. Downloads happen even when `allow_download` is
+    false: this is the explicit request. Raises `ModelError` listing every attempt when all fail.
     """
     cache_file = default_cache_dir(config, environ) / MODEL_FILENAME
-    attempts = [] if tried is None else tried
-    for source in sources:
-        log.info("fetching the face landmarker model from %s", source.description)
-        try:
-            data = source.fetch(config.download_timeout_s)
-        except (OSError, ModelError, subprocess.SubprocessError, ValueError) as exc:
-            reason = str(exc) or type(exc).__name__
-            log.warning("model source %s failed: %s", source.description, reason)
-            attempts.append(f"{source.description}: {reason}")
-            continue
-        problem = check_bytes(data, expected)
-        if problem is not None:
-            log.warning("model from %s rejected: %s", source.description, problem)
-            attempts.append(f"{source.description}: rejected, {problem}")
-            continue
-        try:
-            write_atomically(cache_file, data)
-        except OSError as exc:
-            attempts.append(f"writing {cache_file}: {exc.strerror or exc}")
-            break
-        log.info("face landmarker model saved to %s", cache_file)
-        return cache_file
-    raise ModelError(
-        "face landmarker model unavailable; tried "
-        + "; ".join(attempts)
-        + ". "
-        + _manual_hint(cache_file, expected)
-    )
+    tried: list[str] = []
+    timeout_s = config.download_timeout_s
+    explicit = explicit_model_path(config, environ)
+    if explicit is not None and explicit.resolve() != cache_file.resolve():
+        copied = _download(cache_file, [LocalFileSource(explicit)], timeout_s, expected, tried)
+        if copied is not None:
+            return copied
+    if not force:
+        problem = check_file(cache_file, expected)
+        if problem is None:
+            return cache_file
+        tried.append(f"cache {cache_file}: {problem}")
+    fetched = _download(cache_file, sources, timeout_s, expected, tried)
+    if fetched is None:
+        raise _unavailable(cache_file, expected, tried)
+    return fetched
 
 
 def resolve_model(
@@ -299,4 +347,7 @@ def resolve_model(
             + ". "
             + _manual_hint(cache_file, expected)
         )
-    return fetch_model(config, sources=sources, environ=environ, expected=expected, tried=tried)
+    fetched = _download(cache_file, sources, config.download_timeout_s, expected, tried)
+    if fetched is None:
+        raise _unavailable(cache_file, expected, tried)
+    return fetched

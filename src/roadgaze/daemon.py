@@ -9,13 +9,18 @@ undeclares everything and returns 0.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+import signal
 import threading
 import time
-from collections.abc import Callable
-from typing import Any, Literal, Protocol
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager
+from types import FrameType
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 from roadgaze.config import Config
+from roadgaze.errors import SourceError
 from roadgaze.monitor import Alert, AlertKind, Monitor
 from roadgaze.transport import (
     AlertMessage,
@@ -25,8 +30,12 @@ from roadgaze.transport import (
     StateMessage,
     TransportStatus,
     YawMessage,
+    ZenohLink,
 )
 from roadgaze.types import YawSample
+
+if TYPE_CHECKING:
+    from roadgaze.capture import FrameSource
 
 log = logging.getLogger("roadgaze.daemon")
 
@@ -65,6 +74,8 @@ class MonitorPublisher:
         self._started = time.monotonic()
         self.status: Status = "starting"
         self.source_status = "opening"
+        self.source: FrameSource | None = None
+        """The open frame source, read for its status (camera lost/reconnected)."""
         self.problems: list[str] = []
         self.frames = 0
         self.faces = 0
@@ -82,7 +93,7 @@ class MonitorPublisher:
             return None, "none"
         return speed.current()
 
-    def on_sample(self, sample: YawSample) -> tuple[Alert, ...]:
+    def on_sample(self, sample: YawSample) -> None:
         speed_kmh, _ = self._speed()
         alerts = self.monitor.update(sample, speed_kmh)
         state = self.monitor.state
@@ -122,7 +133,6 @@ class MonitorPublisher:
         self._yaw_seq += 1
         for alert in alerts:
             self._publish_alert(alert, wall_time)
-        return alerts
 
     def _publish_alert(self, alert: Alert, wall_time: float) -> None:
         self.alerts.append(alert)
@@ -150,6 +160,12 @@ class MonitorPublisher:
             else TransportStatus(mode=self.config.zenoh.mode, session_open=False, connected=False)
         )
         problems = list(self.problems)
+        source_status = self.source_status
+        if self.source is not None:
+            current = self.source.status
+            if not current.connected:
+                problems.append(current.message or "camera lost; reconnecting")
+                source_status = "reconnecting"
         if self.link is not None and not transport.connected:
             problems.append("zenoh not connected")
         status = self.status
@@ -164,10 +180,11 @@ class MonitorPublisher:
             t_s=state.t_s,
             uptime_s=time.monotonic() - self._started,
             source=self.source_label,
-            source_status=self.source_status,
+            source_status=source_status,
             frames=self.frames,
             faces=self.faces,
-            camera_reopens=self.camera_reopens,
+            camera_reopens=self.camera_reopens
+            + (self.source.status.reconnects if self.source is not None else 0),
             transport=transport,
             monitor=MonitorSnapshot(
                 gaze=state.gaze.value,
@@ -199,6 +216,10 @@ class MonitorPublisher:
 
     def state_json(self) -> bytes:
         return self.state_message().to_json_bytes()
+
+    def extras(self, sample: YawSample) -> dict[str, Any]:
+        """The monitor's fields for the frame record of `sample` (this sink must run first)."""
+        return self.last_extras
 
     def close(self) -> None:
         """Nothing to release: the link is owned by whoever opened it."""
@@ -238,3 +259,140 @@ class StopFlag:
 
     def wait(self, timeout_s: float) -> bool:
         return self._event.wait(timeout_s)
+
+
+@contextmanager
+def signal_handlers(stop: StopFlag) -> Iterator[None]:
+    """SIGINT/SIGTERM set `stop` (the current frame is finished); a second one exits at once."""
+
+    def on_signal(number: int, frame: FrameType | None) -> None:
+        name = signal.Signals(number).name
+        if stop.is_set():
+            log.warning("second %s: exiting without waiting", name)
+            raise SystemExit(1)
+        log.info("%s received: finishing the current frame", name)
+        stop.set(name)
+
+    previous = {
+        number: signal.signal(number, on_signal) for number in (signal.SIGINT, signal.SIGTERM)
+    }
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+@contextmanager
+def publishing_sink(config: Config, source_label: str, publish: bool) -> Iterator[MonitorPublisher]:
+    """A `MonitorPublisher`, with a Zenoh link when `publish`; on exit the final state is
+    published and everything undeclared."""
+    keys = Keys.from_config(config.zenoh)
+    if not publish:
+        yield MonitorPublisher(config, keys, None, source_label)
+        return
+    speed = SpeedInput(config.zenoh.speed_stale_s) if keys.speed is not None else None
+    holder: list[MonitorPublisher] = []
+    link = ZenohLink(config.zenoh, keys, state_reply=lambda: holder[0].state_json(), speed=speed)
+    sink = MonitorPublisher(config, keys, link, source_label)
+    holder.append(sink)
+    with link:
+        try:
+            yield sink
+        finally:
+            sink.status = "stopped"
+            link.publish_final_state()
+
+
+def _close_when_stopped(stop: StopFlag, source: FrameSource, done: threading.Event) -> None:
+    """Unblock a source that waits for a lost camera once a stop is asked for."""
+    while not done.wait(0.1):
+        if stop.is_set():
+            if not done.wait(1.0):  # the current frame had a second to finish
+                source.close()
+            return
+
+
+def run_daemon(
+    config: Config,
+    source_spec: str,
+    stop: StopFlag | None = None,
+    realtime: bool = True,
+    handle_signals: bool = True,
+) -> int:
+    """Monitor `source_spec` and publish until the source ends or a stop; returns 0.
+
+    A camera that cannot be opened is retried with backoff (capture.reconnect_*), reported in
+    the state as degraded; a missing file is a `SourceError`. An unreachable Zenoh peer never
+    stops monitoring (see `ZenohLink`).
+    """
+    from roadgaze.capture import camera_device, open_source
+    from roadgaze.pipeline import Pipeline, create_detector
+
+    stop = stop if stop is not None else StopFlag()
+    is_camera = camera_device(source_spec) is not None
+    with ExitStack() as stack:
+        if handle_signals:
+            stack.enter_context(signal_handlers(stop))
+        sink = stack.enter_context(publishing_sink(config, source_spec, publish=True))
+        log.info(
+            "roadgaze run: source %s, vehicle %s, prefix %s",
+            source_spec,
+            sink.keys.vehicle_id,
+            sink.keys.prefix,
+        )
+        delay_s = config.capture.reconnect_initial_s
+        offset_s = 0.0
+        while not stop.is_set():
+            try:
+                source = open_source(source_spec, config)
+            except SourceError as exc:
+                if not is_camera:
+                    raise
+                sink.problems = [f"camera unavailable: {exc}"]
+                sink.source_status = "unavailable"
+                sink.camera_reopens += 1
+                log.warning("%s; next try in %.1f s", exc, delay_s)
+                stop.wait(delay_s)
+                delay_s = min(delay_s * 2.0, config.capture.reconnect_max_s)
+                continue
+            delay_s = config.capture.reconnect_initial_s
+            sink.problems = []
+            sink.source_status = "open"
+            done = threading.Event()
+            watcher = threading.Thread(
+                target=_close_when_stopped, args=(stop, source, done), daemon=True
+            )
+            with source:
+                detector = create_detector(config)  # VIDEO mode: one per source timeline
+                try:
+                    sink.source = source
+                    watcher.start()
+                    pipeline = Pipeline.from_config(config, detector)
+                    live = source.info.live
+                    for processed in pipeline.frames(source, realtime=realtime and not live):
+                        sample = processed.sample
+                        if offset_s:
+                            sample = dataclasses.replace(sample, t_s=sample.t_s + offset_s)
+                        sink.on_sample(sample)
+                        if stop.is_set():
+                            break
+                finally:
+                    done.set()
+                    sink.source = None
+                    detector.close()
+            if sink.monitor.state.t_s is not None:
+                offset_s = sink.monitor.state.t_s + 1.0 / (config.capture.fps or 30.0)
+            if not is_camera:
+                sink.source_status = "ended"
+                break
+            if not stop.is_set():
+                sink.problems = ["camera stream ended; reopening"]
+        sink.status = "stopping"
+        log.info(
+            "roadgaze run: stopping (%s) after %d frames, %d alerts",
+            stop.signal_name or "end of source",
+            sink.frames,
+            len(sink.alerts),
+        )
+    return 0

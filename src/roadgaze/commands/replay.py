@@ -65,6 +65,41 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_monitor_arguments(parser)
+
+
+# --- Monitor and Zenoh publishing (roadgaze.monitor / roadgaze.daemon) -------------------------
+
+
+def add_monitor_arguments(parser: argparse.ArgumentParser) -> None:
+    """--publish and the Zenoh options; the monitor itself always runs and fills the records."""
+    from roadgaze.transport import add_zenoh_options
+
+    parser.add_argument(
+        "--publish",
+        action="store_true",
+        help="publish yaw, alerts, liveliness and state on Zenoh, stamped with the video's time",
+    )
+    add_zenoh_options(parser)
+
+
+def monitor_config(args: argparse.Namespace, config: Config) -> Config:
+    from roadgaze.transport import zenoh_config_from_args
+
+    return config.model_copy(update={"zenoh": zenoh_config_from_args(config.zenoh, args)})
+
+
+def report_alerts(args: argparse.Namespace, alerts: list[Any]) -> None:
+    for alert in alerts:
+        print(
+            f"replay {args.source}: alert {alert.kind.value} {alert.level.value} "
+            f"at t={alert.t_s:.2f}s (off road {alert.off_road_s:.2f}s, "
+            f"window {alert.window_off_road_s:.2f}s)",
+            file=sys.stderr,
+        )
+
+
+# --- end of monitor and Zenoh publishing -------------------------------------------------------
 
 
 class ReplayStats:
@@ -153,19 +188,27 @@ def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) ->
 
 def run(args: argparse.Namespace) -> int:
     from roadgaze.capture import open_source
+    from roadgaze.daemon import publishing_sink
     from roadgaze.errors import ConfigError
     from roadgaze.pipeline import Pipeline, create_detector
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
-    config = config_from_args(args)
+    config = monitor_config(args, config_from_args(args))
     stats = ReplayStats()
     with ExitStack() as stack:
         source = stack.enter_context(open_source(args.source, config))
         detector = create_detector(config)
         stack.callback(detector.close)
-        sinks: list[Sink] = [stats, *build_sinks(args, config, source.info, stack)]
+        monitor = stack.enter_context(publishing_sink(config, args.source, args.publish))
+        extras = [*record_extras(args, config), monitor.extras]
+        sinks: list[Sink] = [
+            stats,
+            monitor,
+            *build_sinks(args, config, source.info, stack, extras),
+        ]
         pipeline = Pipeline.from_config(config, detector)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
     report(args, summary, stats)
+    report_alerts(args, monitor.alerts)
     return 0

@@ -10,7 +10,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any
+from typing import IO, Any
 
 import zenoh
 
@@ -67,14 +67,15 @@ def wait_for(predicate: Callable[[], bool], timeout_s: float = 10.0, every_s: fl
 class LineReader:
     """Reads a subprocess's stdout lines into a queue on a thread (never blocks the test)."""
 
-    def __init__(self, process: subprocess.Popen[str]) -> None:
+    def __init__(self, process: subprocess.Popen[str], stream: IO[str] | None = None) -> None:
         self.lines: queue.Queue[str] = queue.Queue()
-        self._thread = threading.Thread(target=self._pump, args=(process,), daemon=True)
+        stream = stream if stream is not None else process.stdout
+        assert stream is not None
+        self._thread = threading.Thread(target=self._pump, args=(stream,), daemon=True)
         self._thread.start()
 
-    def _pump(self, process: subprocess.Popen[str]) -> None:
-        assert process.stdout is not None
-        for line in process.stdout:
+    def _pump(self, stream: IO[str]) -> None:
+        for line in stream:
             self.lines.put(line.rstrip("\n"))
 
     def next(self, timeout_s: float) -> str | None:

@@ -169,7 +169,7 @@ class MonitorPublisher:
         if self.link is not None and not transport.connected:
             problems.append("zenoh not connected")
         status = self.status
-        if status == "running" and problems:
+        if status in ("starting", "running") and problems:
             status = "degraded"
         monitor = self.config.monitor
         return StateMessage(

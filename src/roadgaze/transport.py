@@ -212,6 +212,12 @@ def session_config_dict(config: ZenohConfig) -> dict[str, Any]:
         settings["mode"] = config.mode
     if wanted("connect") and config.connect:
         settings["connect/endpoints"] = list(config.connect)
+        # Zenoh retries unreachable endpoints in the background; as often as roadgaze would.
+        settings["connect/retry"] = {
+            "period_init_ms": round(config.reconnect_initial_s * 1000),
+            "period_max_ms": round(config.reconnect_max_s * 1000),
+            "period_increase_factor": 2,
+        }
     if wanted("listen") and config.mode == "peer":
         settings["listen/endpoints"] = list(config.listen)
     if wanted("multicast_scouting"):
@@ -220,6 +226,11 @@ def session_config_dict(config: ZenohConfig) -> dict[str, Any]:
         # Zenoh's client refuses to open without a router; roadgaze retries itself instead.
         settings["connect/timeout_ms"] = 2000
     return settings
+
+
+def zenoh_error_text(exc: BaseException) -> str:
+    """Zenoh's error message without the Rust source location it appends."""
+    return str(exc).split(" at /")[0].rstrip(". ") or type(exc).__name__
 
 
 def build_zenoh_config(config: ZenohConfig) -> Any:
@@ -244,7 +255,7 @@ def build_zenoh_config(config: ZenohConfig) -> Any:
     except TransportError:
         raise
     except Exception as exc:  # zenoh raises its own ZError for bad endpoints or files
-        raise TransportError(f"bad zenoh configuration: {exc}") from None
+        raise TransportError(f"bad zenoh configuration: {zenoh_error_text(exc)}") from None
     return zconf
 
 
@@ -379,7 +390,9 @@ def open_session(config: ZenohConfig) -> Any:
     try:
         return zenoh.open(zconf)
     except Exception as exc:
-        raise TransportError(f"cannot open a zenoh session ({config.mode}): {exc}") from None
+        raise TransportError(
+            f"cannot open a zenoh session ({config.mode}): {zenoh_error_text(exc)}"
+        ) from None
 
 
 class ZenohLink:
@@ -433,7 +446,7 @@ class ZenohLink:
             session = zenoh.open(self._zconf)
             declared = _Declared(session, self.keys, self._state_reply, self.speed)
         except Exception as exc:
-            self.last_error = str(exc).split(" at /")[0]
+            self.last_error = zenoh_error_text(exc)
             log.warning("zenoh session not available (%s); monitoring goes on", self.last_error)
             return False
         self.last_error = None

@@ -356,6 +356,13 @@ def test_daemon_reports_an_unavailable_camera_and_stops_cleanly(hub: tuple[Hub, 
             timeout_s=15.0,
         )
         state = recorder.query_state()
+        health = roadgaze(
+            "listen", "--query-state", "--vehicle-id", "e2e", "--zenoh-connect", endpoint(port)
+        )
+        try:
+            health_out, _ = health.communicate(timeout=60)
+        finally:
+            stop_process(health)
         assert daemon.poll() is None
         daemon.send_signal(signal.SIGTERM)
         assert daemon.wait(timeout=20) == 0
@@ -365,6 +372,8 @@ def test_daemon_reports_an_unavailable_camera_and_stops_cleanly(hub: tuple[Hub, 
     assert state["status"] == "degraded" and state["source_status"] == "unavailable"
     assert "camera unavailable" in state["problems"][0]
     assert state["frames"] == 0
+    assert health.returncode == 3  # answered, but degraded: the container health check fails
+    assert "status=degraded" in health_out
     assert wait_for(lambda: recorder.alive == [True, False], timeout_s=5.0)
 
 

@@ -24,7 +24,8 @@ def register(subparsers: Any) -> None:
         description="Subscribe to vehicle/<id>/dms/{yaw,alert,state} and the liveliness token "
         "vehicle/<id>/dms/alive, and print each message: readable lines, or one JSON object per "
         "line with --json. Without --vehicle-id every vehicle is shown. With --query-state, ask "
-        "the state queryable once, print the answers and exit (0 when at least one answered).",
+        "the state queryable once, print the answers and exit: 0 when every answer says running, "
+        "3 when one is degraded (or starting/stopping), 1 without an answer (a health check).",
     )
     add_zenoh_options(parser)
     parser.add_argument("--json", action="store_true", help="one JSON object per line")
@@ -125,14 +126,21 @@ def run(args: argparse.Namespace) -> int:
     with open_session(zconf) as session:
         if args.query_state:
             timeout_s = 5.0 if args.timeout is None else args.timeout
-            answers = 0
-            for reply in session.get(keys.state, timeout=timeout_s):
-                if reply.ok is not None:
-                    answers += 1
-                    print_line("state", str(reply.ok.key_expr), reply.ok.payload.to_bytes())
-            if not answers:
+            statuses: list[str] = []
+            query_deadline = time.monotonic() + timeout_s
+            while not statuses and time.monotonic() < query_deadline:
+                # Right after opening, the routes to the queryable may not be known yet: ask again.
+                wait_s = max(0.05, min(1.0, query_deadline - time.monotonic()))
+                for reply in session.get(keys.state, timeout=wait_s):
+                    if reply.ok is not None:
+                        raw = reply.ok.payload.to_bytes()
+                        print_line("state", str(reply.ok.key_expr), raw)
+                        payload, _ = _decode(raw)
+                        statuses.append(str((payload or {}).get("status")))
+            if not statuses:
                 print(f"roadgaze listen: no answer from {keys.state}", file=sys.stderr)
-            return 0 if answers else 1
+                return 1
+            return 0 if all(status == "running" for status in statuses) else 3
 
         def on_data(sample: Any) -> None:
             key = str(sample.key_expr)

@@ -387,3 +387,102 @@ def test_run_with_a_missing_file_is_one_line_error(tmp_path: Path) -> None:
         stop_process(process)
     assert process.returncode == 2
     assert stderr.strip().splitlines()[-1].startswith("roadgaze run: error: no video file")
+
+
+class FakeCamera:
+    """A V4L2 stand-in: `frames` reads at about 30 fps, then reads fail (unplugged)."""
+
+    def __init__(self, image: Any, frames: int | None) -> None:
+        self.image, self.frames_left = image, frames
+
+    def isOpened(self) -> bool:  # noqa: N802 (OpenCV's name)
+        return True
+
+    def read(self) -> tuple[bool, Any]:
+        time.sleep(1 / 30)
+        if self.frames_left is not None:
+            if self.frames_left <= 0:
+                return False, None
+            self.frames_left -= 1
+        return True, self.image.copy()
+
+    def get(self, prop_id: int) -> float:
+        return 0.0
+
+    def set(self, prop_id: int, value: float) -> bool:
+        return True
+
+    def release(self) -> None:
+        return None
+
+
+class Unplugged(FakeCamera):
+    def isOpened(self) -> bool:  # noqa: N802
+        return False
+
+
+@needs_data
+@pytest.mark.slow
+def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
+    hub: tuple[Hub, int], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import threading
+
+    import cv2
+
+    import roadgaze.capture as capture
+    from roadgaze.daemon import StopFlag, run_daemon
+
+    recorder, port = hub
+    image = cv2.imread(str(FRONTAL))
+    # First plug: 30 frames then the camera vanishes; two failed re-opens; then it is back.
+    plugs = iter([FakeCamera(image, 30), Unplugged(image, 0), Unplugged(image, 0)])
+
+    def factory(device: int | str) -> FakeCamera:
+        return next(plugs, None) or FakeCamera(image, None)
+
+    def open_fake(spec: str, config: Config | None = None) -> capture.FrameSource:
+        assert config is not None
+        return capture.CameraSource(spec, config.capture, capture_factory=factory)
+
+    monkeypatch.setattr(capture, "open_source", open_fake)
+    config = Config.model_validate(
+        {
+            "zenoh": {"vehicle_id": "e2e", "connect": [endpoint(port)]},
+            "capture": {"reconnect_initial_s": 0.3, "reconnect_max_s": 1.0},
+        }
+    )
+    stop = StopFlag()
+    result: list[int] = []
+    thread = threading.Thread(
+        target=lambda: result.append(run_daemon(config, "/dev/video42", stop, True, False)),
+        daemon=True,
+    )
+    thread.start()
+    states: list[dict[str, Any]] = []
+    try:
+
+        def poll(predicate: Any) -> bool:
+            state = recorder.query_state()
+            if state is not None:
+                states.append(state)
+            return state is not None and bool(predicate(state))
+
+        assert wait_for(lambda: poll(lambda s: s["source_status"] == "reconnecting"), 60.0, 0.1)
+        assert wait_for(lambda: poll(lambda s: s["camera_reopens"] >= 1), 30.0, 0.1)
+        reopened_at = states[-1]["frames"]
+        assert wait_for(lambda: poll(lambda s: s["frames"] >= reopened_at + 10), 30.0, 0.1)
+    finally:
+        stop.set("test")
+        thread.join(timeout=30)
+    assert result == [0]
+    lost = next(s for s in states if s["source_status"] == "reconnecting")
+    assert lost["status"] == "degraded" and "lost" in lost["problems"][0]
+    assert 0 < lost["frames"] <= 30  # newest-frame-only: some of the 30 may be dropped
+    back = states[-1]
+    print(
+        f"lost: {lost['status']} {lost['problems']} after {lost['frames']} frames; back: "
+        f"{back['status']}, camera_reopens {back['camera_reopens']}, frames {back['frames']}"
+    )
+    assert back["status"] == "running" and back["problems"] == []
+    assert recorder.of("state")[-1]["status"] == "stopped"

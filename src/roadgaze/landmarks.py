@@ -20,8 +20,12 @@ unmirrored camera sees as the nose pointing to the image right.
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Sequence
+import os
+import sys
+import tempfile
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -256,6 +260,8 @@ def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
         raise ValueError(f"expected a uint8 image, found dtype {array.dtype}")
     if array.ndim == 3 and array.shape[2] == 1:
         array = array[:, :, 0]
+    if array.ndim in (2, 3) and (array.shape[0] < 1 or array.shape[1] < 1):
+        raise ValueError(f"empty image of shape {array.shape}")
     if array.ndim == 2:
         rgb = cv2.cvtColor(array, cv2.COLOR_GRAY2RGB)
     elif array.ndim == 3 and array.shape[2] == 3:
@@ -264,9 +270,42 @@ def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
         rgb = cv2.cvtColor(array, cv2.COLOR_BGRA2RGB)
     else:
         raise ValueError(f"expected a grayscale, BGR or BGRA image, found shape {array.shape}")
-    if rgb.shape[0] < 1 or rgb.shape[1] < 1:
-        raise ValueError(f"empty image of shape {array.shape}")
     return np.ascontiguousarray(rgb)
+
+
+_NATIVE_NOISE = (
+    "WARNING: Logging before InitGoogle()",
+    "INFO: Created TensorFlow Lite",
+    "W0000 ",
+    "I0000 ",
+)
+
+
+@contextlib.contextmanager
+def _filtered_native_stderr() -> Iterator[None]:
+    """Drop MediaPipe's start-up log lines (written by C++ to fd 2); pass every other line on."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):
+        yield
+        return
+    with tempfile.TemporaryFile(mode="w+b") as capture:
+        os.dup2(capture.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            capture.seek(0)
+            kept = [
+                line
+                for line in capture.read().decode("utf-8", "replace").splitlines(keepends=True)
+                if not line.startswith(_NATIVE_NOISE)
+            ]
+            if kept:
+                sys.stderr.write("".join(kept))
+                sys.stderr.flush()
 
 
 class MediaPipeLandmarker:
@@ -306,7 +345,8 @@ class MediaPipeLandmarker:
             output_facial_transformation_matrixes=True,
         )
         try:
-            self._landmarker: Any = vision.FaceLandmarker.create_from_options(options)
+            with _filtered_native_stderr():
+                self._landmarker: Any = vision.FaceLandmarker.create_from_options(options)
         except (RuntimeError, ValueError, OSError) as exc:
             raise ModelError(f"cannot load face landmarker model {model_path}: {exc}") from None
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -27,7 +28,9 @@ from roadgaze.landmarks import (
     angles_from_matrix_deg,
     choose_driver,
     features_from_landmarks,
+    merge_mirrored,
     roll_from_eyes_deg,
+    unmirror,
 )
 from roadgaze.model_store import resolve_model
 from roadgaze.types import FaceFeatures
@@ -71,9 +74,6 @@ def rotate(points: npt.NDArray[np.float32], angle_deg: float, pivot: tuple[float
     rotated = points.copy()
     rotated[:, :2] = points[:, :2] @ matrix[:, :2].T + matrix[:, 2]
     return rotated
-
-
-from typing import Any  # noqa: E402
 
 
 def test_upright_face_features() -> None:
@@ -410,3 +410,41 @@ def test_mirrored_turned_faces_roughly_negate_yaw(landmarker: MediaPipeLandmarke
     assert len(sums) >= 20
     assert float(np.median(sums)) < 1.5
     assert max(sums) < 10.0
+
+
+def test_unmirror_is_an_involution_that_negates_yaw() -> None:
+    face = features_from_landmarks(synthetic_face(nose_offset_px=15.0), (400, 300))
+    flipped = unmirror(face, 400)
+    assert (flipped.x_left_px, flipped.x_right_px) == pytest.approx(
+        (400 - face.x_right_px, 400 - face.x_left_px)
+    )
+    yaw = center_ce(face.x_left_px, face.x_right_px, face.x_center_px)
+    assert center_ce(flipped.x_left_px, flipped.x_right_px, flipped.x_center_px) == pytest.approx(
+        -yaw, abs=1e-9
+    )
+    back = unmirror(flipped, 400)
+    assert back.box_px == pytest.approx(face.box_px)
+    assert back.x_center_px == pytest.approx(face.x_center_px)
+
+
+def test_merge_mirrored_averages_matched_faces_and_keeps_the_rest() -> None:
+    face = features_from_landmarks(synthetic_face(nose_offset_px=10.0), (400, 300))
+    # The same face measured in the flipped image with a nose 4 px further out.
+    flipped_measurement = unmirror(
+        features_from_landmarks(synthetic_face(nose_offset_px=14.0), (400, 300)), 400
+    )
+    far_away = features_from_landmarks(synthetic_face(center=(60.0, 60.0)), (400, 300))
+    merged = merge_mirrored([face], [flipped_measurement, far_away], 400)
+    assert len(merged) == 2
+    assert merged[0].x_center_px == pytest.approx(212.0, abs=1e-4)
+    assert merged[1].box_px == pytest.approx(unmirror(far_away, 400).box_px)
+    assert merge_mirrored([face], [], 400) == [face]
+
+
+def test_mirror_average_is_exactly_symmetric(
+    model_path: Path, astronaut: npt.NDArray[np.uint8]
+) -> None:
+    with MediaPipeLandmarker(LandmarksConfig(mirror_average=True), model_path) as detector:
+        yaw = center_ce_of(detector.detect(astronaut).driver)
+        mirrored = center_ce_of(detector.detect(np.ascontiguousarray(astronaut[:, ::-1])).driver)
+    assert mirrored == pytest.approx(-yaw, abs=1e-6)

@@ -57,6 +57,9 @@ class LandmarksConfig(_Section):
     min_tracking_confidence: float = Field(default=0.5, ge=0, le=1)
     driver: Literal["largest", "left", "right"] = "largest"
     """Which face is the driver: the largest, or the one on the image's left or right side."""
+    mirror_average: bool = False
+    """Also run the mirrored image and average the two measurements: exactly mirror-symmetric
+    yaw and slightly better accuracy (docs/landmarks.md) for twice the landmarker time."""
 
 
 class CaptureConfig(_Section):

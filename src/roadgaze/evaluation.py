@@ -204,13 +204,15 @@ def _close_worker() -> None:
 def _init_worker(
     landmarks_config: LandmarksConfig, model_path: Path, constants: FaceModelConstants
 ) -> None:
-    import atexit
+    from multiprocessing.util import Finalize
 
     from roadgaze.landmarks import MediaPipeLandmarker
 
     _worker["detector"] = MediaPipeLandmarker(landmarks_config, model_path, video=False)
     _worker["constants"] = constants
-    atexit.register(_close_worker)
+    # Runs when the worker leaves its loop, while MediaPipe's threads are still alive (an atexit
+    # hook would run after they are gone and fail).
+    Finalize(None, _close_worker, exitpriority=10)
 
 
 def _worker_estimate(job: tuple[Path, str]) -> ImageEstimate:

@@ -20,8 +20,12 @@ unmirrored camera sees as the nose pointing to the image right.
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Sequence
+import os
+import sys
+import tempfile
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -247,6 +251,77 @@ def choose_driver(faces: Sequence[FaceFeatures], rule: str) -> int | None:
     raise ValueError(f"unknown driver rule '{rule}'; choose largest, left or right")
 
 
+def _box_iou(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> float:
+    width = min(a[2], b[2]) - max(a[0], b[0])
+    height = min(a[3], b[3]) - max(a[1], b[1])
+    if width <= 0 or height <= 0:
+        return 0.0
+    inter = width * height
+    area_a = (a[2] - a[0]) * (a[3] - a[1])
+    area_b = (b[2] - b[0]) * (b[3] - b[1])
+    return inter / (area_a + area_b - inter)
+
+
+def unmirror(face: FaceFeatures, image_width_px: int) -> FaceFeatures:
+    """A face measured in the horizontally flipped image, expressed in the original image.
+
+    x becomes width - x (so left and right boundaries swap), roll and yaw change sign. The
+    landmark array is flipped in x but keeps MediaPipe's indices of the flipped face.
+    """
+    width = float(image_width_px)
+    points = face.landmarks_px.copy()
+    points[:, 0] = width - points[:, 0]
+    x_min, y_min, x_max, y_max = face.box_px
+    return FaceFeatures(
+        x_left_px=width - face.x_right_px,
+        x_right_px=width - face.x_left_px,
+        x_center_px=width - face.x_center_px,
+        roll_deg=-face.roll_deg,
+        box_px=(width - x_max, y_min, width - x_min, y_max),
+        quality=face.quality,
+        landmarks_px=points,
+        mediapipe_yaw_deg=None if face.mediapipe_yaw_deg is None else -face.mediapipe_yaw_deg,
+        mediapipe_pitch_deg=face.mediapipe_pitch_deg,
+    )
+
+
+def _mean(a: float | None, b: float | None) -> float | None:
+    return None if a is None or b is None else 0.5 * (a + b)
+
+
+def merge_mirrored(
+    faces: Sequence[FaceFeatures], mirrored_faces: Sequence[FaceFeatures], image_width_px: int
+) -> list[FaceFeatures]:
+    """Average each face with its measurement in the flipped image (matched by box overlap).
+
+    The result is exactly mirror-symmetric: flipping the input negates every yaw. A face found in
+    only one of the two images is kept as found there.
+    """
+    candidates = [unmirror(face, image_width_px) for face in mirrored_faces]
+    merged: list[FaceFeatures] = []
+    for face in faces:
+        overlaps = [_box_iou(face.box_px, other.box_px) for other in candidates]
+        best = int(np.argmax(overlaps)) if overlaps else -1
+        if best < 0 or overlaps[best] < 0.3:
+            merged.append(face)
+            continue
+        other = candidates.pop(best)
+        merged.append(
+            FaceFeatures(
+                x_left_px=0.5 * (face.x_left_px + other.x_left_px),
+                x_right_px=0.5 * (face.x_right_px + other.x_right_px),
+                x_center_px=0.5 * (face.x_center_px + other.x_center_px),
+                roll_deg=0.5 * (face.roll_deg + other.roll_deg),
+                box_px=tuple(0.5 * (p + q) for p, q in zip(face.box_px, other.box_px, strict=True)),  # type: ignore[arg-type]
+                quality=0.5 * (face.quality + other.quality),
+                landmarks_px=face.landmarks_px,
+                mediapipe_yaw_deg=_mean(face.mediapipe_yaw_deg, other.mediapipe_yaw_deg),
+                mediapipe_pitch_deg=_mean(face.mediapipe_pitch_deg, other.mediapipe_pitch_deg),
+            )
+        )
+    return merged + candidates
+
+
 def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
     """A contiguous RGB uint8 copy of a BGR, BGRA or grayscale image; ValueError otherwise."""
     import cv2
@@ -256,6 +331,8 @@ def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
         raise ValueError(f"expected a uint8 image, found dtype {array.dtype}")
     if array.ndim == 3 and array.shape[2] == 1:
         array = array[:, :, 0]
+    if array.ndim in (2, 3) and (array.shape[0] < 1 or array.shape[1] < 1):
+        raise ValueError(f"empty image of shape {array.shape}")
     if array.ndim == 2:
         rgb = cv2.cvtColor(array, cv2.COLOR_GRAY2RGB)
     elif array.ndim == 3 and array.shape[2] == 3:
@@ -264,9 +341,42 @@ def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
         rgb = cv2.cvtColor(array, cv2.COLOR_BGRA2RGB)
     else:
         raise ValueError(f"expected a grayscale, BGR or BGRA image, found shape {array.shape}")
-    if rgb.shape[0] < 1 or rgb.shape[1] < 1:
-        raise ValueError(f"empty image of shape {array.shape}")
     return np.ascontiguousarray(rgb)
+
+
+_NATIVE_NOISE = (
+    "WARNING: Logging before InitGoogle()",
+    "INFO: Created TensorFlow Lite",
+    "W0000 ",
+    "I0000 ",
+)
+
+
+@contextlib.contextmanager
+def _filtered_native_stderr() -> Iterator[None]:
+    """Drop MediaPipe's start-up log lines (written by C++ to fd 2); pass every other line on."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):
+        yield
+        return
+    with tempfile.TemporaryFile(mode="w+b") as capture:
+        os.dup2(capture.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            capture.seek(0)
+            kept = [
+                line
+                for line in capture.read().decode("utf-8", "replace").splitlines(keepends=True)
+                if not line.startswith(_NATIVE_NOISE)
+            ]
+            if kept:
+                sys.stderr.write("".join(kept))
+                sys.stderr.flush()
 
 
 class MediaPipeLandmarker:
@@ -305,8 +415,13 @@ class MediaPipeLandmarker:
             min_tracking_confidence=landmarks_config.min_tracking_confidence,
             output_facial_transformation_matrixes=True,
         )
+        self._landmarker: Any = None
+        self._mirror_landmarker: Any = None
         try:
-            self._landmarker: Any = vision.FaceLandmarker.create_from_options(options)
+            with _filtered_native_stderr():
+                self._landmarker = vision.FaceLandmarker.create_from_options(options)
+                if landmarks_config.mirror_average:
+                    self._mirror_landmarker = vision.FaceLandmarker.create_from_options(options)
         except (RuntimeError, ValueError, OSError) as exc:
             raise ModelError(f"cannot load face landmarker model {model_path}: {exc}") from None
 
@@ -330,8 +445,7 @@ class MediaPipeLandmarker:
         if self._landmarker is None:
             raise ValueError("landmarker is closed")
         rgb = to_rgb(image)
-        height, width = rgb.shape[:2]
-        mp_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb)
+        timestamp_ms: int | None = None
         if self._video:
             if t_s is None:
                 raise ValueError("VIDEO mode needs a timestamp t_s for every frame")
@@ -342,11 +456,25 @@ class MediaPipeLandmarker:
             # MediaPipe needs strictly increasing integer milliseconds.
             timestamp_ms = max(round(t_s * 1000.0), self._last_ms + 1)
             self._last_t_s, self._last_ms = t_s, timestamp_ms
-            result = self._landmarker.detect_for_video(mp_image, timestamp_ms)
+        elif t_s is not None:
+            raise ValueError("IMAGE mode takes no timestamp; construct with video=True")
+        faces = self._run(self._landmarker, rgb, timestamp_ms)
+        if self._mirror_landmarker is not None:
+            mirrored = self._run(
+                self._mirror_landmarker, np.ascontiguousarray(rgb[:, ::-1]), timestamp_ms
+            )
+            faces = merge_mirrored(faces, mirrored, rgb.shape[1])
+        return Detection(faces=tuple(faces), driver_index=choose_driver(faces, self._config.driver))
+
+    def _run(
+        self, landmarker: Any, rgb: npt.NDArray[np.uint8], timestamp_ms: int | None
+    ) -> list[FaceFeatures]:
+        height, width = rgb.shape[:2]
+        mp_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb)
+        if timestamp_ms is None:
+            result = landmarker.detect(mp_image)
         else:
-            if t_s is not None:
-                raise ValueError("IMAGE mode takes no timestamp; construct with video=True")
-            result = self._landmarker.detect(mp_image)
+            result = landmarker.detect_for_video(mp_image, timestamp_ms)
         faces: list[FaceFeatures] = []
         matrices = result.facial_transformation_matrixes or []
         for index, face in enumerate(result.face_landmarks):
@@ -358,12 +486,15 @@ class MediaPipeLandmarker:
                 faces.append(features_from_landmarks(points, (width, height), matrix, self._choice))
             except ValueError:
                 continue
-        return Detection(faces=tuple(faces), driver_index=choose_driver(faces, self._config.driver))
+        return faces
 
     def close(self) -> None:
         if self._landmarker is not None:
             self._landmarker.close()
             self._landmarker = None
+        if self._mirror_landmarker is not None:
+            self._mirror_landmarker.close()
+            self._mirror_landmarker = None
 
     def __enter__(self) -> Self:
         return self

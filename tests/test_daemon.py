@@ -486,3 +486,24 @@ def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
     )
     assert back["status"] == "running" and back["problems"] == []
     assert recorder.of("state")[-1]["status"] == "stopped"
+
+
+@pytest.mark.parametrize(
+    ("speed_payload", "expected"), [(b'{"kmh": 10}', 0), (b"50", 2), (None, 2)]
+)
+def test_sink_gates_alerts_on_the_speed_received(
+    speed_payload: bytes | None, expected: int
+) -> None:
+    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
+    link = FakeLink(speed=SpeedInput(stale_s=5.0))
+    assert link.speed is not None
+    if speed_payload is not None:
+        link.speed.on_payload(speed_payload)
+    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), link, "test")
+    for frame in range(180):
+        t_s = frame / 30
+        sink.on_sample(sample(t_s, 45.0 if 1.0 <= t_s < 5.0 else 0.0))
+    assert len(link.alerts) == expected
+    state = sink.state_message()
+    assert state.monitor.speed_source == ("waiting" if speed_payload is None else "fresh")
+    assert state.monitor.moving is (expected > 0)

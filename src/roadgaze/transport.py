@@ -50,7 +50,12 @@ PENDING_FLUSH_WAIT_S = 2.0
 
 
 class _Message(BaseModel):
-    model_config = ConfigDict(frozen=True, populate_by_name=True, extra="forbid")
+    model_config = ConfigDict(
+        frozen=True,
+        populate_by_name=True,
+        extra="forbid",
+        json_schema_serialization_defaults_required=True,  # every field is always published
+    )
 
     def to_json_bytes(self) -> bytes:
         return self.model_dump_json(by_alias=True).encode("utf-8")
@@ -158,7 +163,10 @@ MESSAGE_MODELS: dict[str, type[_Message]] = {
 
 def json_schemas() -> dict[str, dict[str, Any]]:
     """The JSON Schema of every published message, by name."""
-    return {name: model.model_json_schema(by_alias=True) for name, model in MESSAGE_MODELS.items()}
+    return {
+        name: model.model_json_schema(by_alias=True, mode="serialization")
+        for name, model in MESSAGE_MODELS.items()
+    }
 
 
 @dataclass(frozen=True, slots=True)

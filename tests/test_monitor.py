@@ -197,6 +197,13 @@ def test_speed_gating(speed_kmh: float | None, min_speed_kmh: float, expect_aler
     )
 
 
+def test_no_vats_when_the_window_fills_as_the_vehicle_stops() -> None:
+    starts = [1.0 + 3.5 * k for k in range(4)]  # 10 s off road exactly at t = 14.0 s
+    speed = lambda t: 50.0 if t < starts[3] + 2.5 else 5.0  # noqa: E731
+    _, alerts = run(glances(starts, 2.5), 16.0, speed_at=speed)
+    assert alerts == []
+
+
 def test_off_road_time_counts_only_from_when_the_vehicle_moves() -> None:
     speed = lambda t: 10.0 if t < 3.0 else 40.0  # noqa: E731
     _, alerts = run(glances([1.0], 7.0), 9.0, speed_at=speed)

@@ -298,7 +298,8 @@ def step(
     # Evaluated on every sample: an episode that ends exactly at the threshold is counted at the
     # sample that ends it, i.e. when the driver looks back; it is cleared at the next one.
     just_ended = state.off_since_s is not None and off_since is None
-    if (counted_off or just_ended) and vats_armed and window_s >= config.vats_threshold_s - _EPS_S:
+    vats_due = counted_off or (just_ended and moving)
+    if vats_due and vats_armed and window_s >= config.vats_threshold_s - _EPS_S:
         alerts.append(alert(AlertKind.VATS, AlertLevel.WARNING))
         vats_armed = False
 

@@ -36,6 +36,7 @@ from roadgaze.types import YawSample
 
 if TYPE_CHECKING:
     from roadgaze.capture import FrameSource
+    from roadgaze.types import LandmarkDetector
 
 log = logging.getLogger("roadgaze.daemon")
 
@@ -343,7 +344,13 @@ def run_daemon(
         )
         delay_s = config.capture.reconnect_initial_s
         offset_s = 0.0
+        detector: LandmarkDetector | None = None
+        stack.callback(lambda: detector.close() if detector is not None else None)
         while not stop.is_set():
+            if detector is None:
+                # Ready before the camera opens, so no frame waits for MediaPipe to load; VIDEO
+                # mode needs one detector per source timeline.
+                detector = create_detector(config)
             try:
                 source = open_source(source_spec, config)
             except SourceError as exc:
@@ -364,7 +371,6 @@ def run_daemon(
                 target=_close_when_stopped, args=(stop, source, done), daemon=True
             )
             with source:
-                detector = create_detector(config)  # VIDEO mode: one per source timeline
                 try:
                     sink.source = source
                     watcher.start()
@@ -381,6 +387,7 @@ def run_daemon(
                     done.set()
                     sink.source = None
                     detector.close()
+                    detector = None
             if sink.monitor.state.t_s is not None:
                 offset_s = sink.monitor.state.t_s + 1.0 / (config.capture.fps or 30.0)
             if not is_camera:

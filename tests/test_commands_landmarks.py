@@ -140,3 +140,35 @@ def test_eval_bad_dataset_is_one_line_error(
     assert main(["eval", str(tmp_path), "--no-progress"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "ground_truth.csv not found" in err
+
+
+def test_estimate_as_a_process_has_clean_stderr(
+    folder: Path, real_model: Path, subprocess_env: dict[str, str]
+) -> None:
+    """No traceback and no MediaPipe start-up noise; the bad file is named on one line."""
+    import subprocess
+    import sys
+
+    env = {**subprocess_env, "ROADGAZE_MODEL_PATH": str(real_model)}
+    completed = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "roadgaze",
+            "estimate",
+            str(folder / "corrupt.jpg"),
+            str(folder / "astronaut.png"),
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+    assert completed.returncode == 1
+    lines = [json.loads(line) for line in completed.stdout.splitlines()]
+    assert [line["face"] for line in lines] == [False, True]
+    assert completed.stderr.strip().splitlines() == [
+        f"roadgaze estimate: {folder / 'corrupt.jpg'}: cannot decode as an image (corrupt or "
+        "unsupported format)"
+    ]

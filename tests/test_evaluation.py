@@ -239,6 +239,20 @@ def _check_bad_input_results(results: list[ImageEstimate]) -> None:
         assert result.to_json_dict()["error"] == result.error
 
 
+def test_exif_orientation_is_applied(tmp_path: Path) -> None:
+    from PIL import Image
+
+    from roadgaze.evaluation import read_image
+
+    upright = skimage_data.astronaut()[:, :400]  # not square, so the orientation shows
+    stored = Image.fromarray(np.ascontiguousarray(np.rot90(upright, 1)))
+    exif = Image.Exif()
+    exif[0x0112] = 6  # "rotate 90 deg clockwise to display"
+    stored.save(tmp_path / "phone.jpg", exif=exif.tobytes())
+    image = read_image(tmp_path / "phone.jpg")
+    assert image.shape == (512, 400, 3)
+
+
 def test_bad_inputs_do_not_stop_the_others(image_folder: Path, model_path: Path) -> None:
     jobs = [(image_folder / name, name) for name in NAMES]
     results = list(estimate_images(jobs, LandmarksConfig(), model_path, workers=1))

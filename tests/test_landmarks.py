@@ -448,3 +448,53 @@ def test_mirror_average_is_exactly_symmetric(
         yaw = center_ce_of(detector.detect(astronaut).driver)
         mirrored = center_ce_of(detector.detect(np.ascontiguousarray(astronaut[:, ::-1])).driver)
     assert mirrored == pytest.approx(-yaw, abs=1e-6)
+
+
+def test_largest_rule_keeps_the_previous_driver_among_similar_faces() -> None:
+    faces = [_face_at(500, 100), _face_at(100, 104)]
+    assert choose_driver(faces, "largest") == 1
+    assert choose_driver(faces, "largest", previous_box_px=faces[0].box_px) == 0
+    # A clearly larger face (>= 1.25 x the area) takes over.
+    bigger = [_face_at(500, 100), _face_at(100, 115)]
+    assert choose_driver(bigger, "largest", previous_box_px=bigger[0].box_px) == 1
+    # The previous driver is gone: the largest face is chosen afresh.
+    assert choose_driver(faces, "largest", previous_box_px=(0.0, 0.0, 20.0, 20.0)) == 1
+
+
+VIDEOS = REPO_ROOT.parent / "shared" / "data" / "videos"
+
+
+@pytest.mark.skipif(not VIDEOS.is_dir(), reason=f"evaluation data not found at {VIDEOS}")
+def test_driver_stays_the_same_person_in_a_two_person_video(model_path: Path) -> None:
+    capture = cv2.VideoCapture(str(VIDEOS / "head-pose-face-detection-female-and-male.gif"))
+    sides = []
+    with MediaPipeLandmarker(LandmarksConfig(), model_path, video=True) as detector:
+        for index in range(56):
+            ok, frame = capture.read()
+            if not ok:
+                break
+            detection = detector.detect(frame, index / 12.0)
+            assert len(detection.faces) == 2
+            driver = detection.driver
+            assert driver is not None
+            sides.append(0.5 * (driver.box_px[0] + driver.box_px[2]) < frame.shape[1] / 2)
+    capture.release()
+    assert len(sides) == 56
+    assert len(set(sides)) == 1
+
+
+@pytest.mark.skipif(not VIDEOS.is_dir(), reason=f"evaluation data not found at {VIDEOS}")
+def test_video_mode_follows_a_head_sweep(model_path: Path) -> None:
+    """The female clip turns from her right (about -55 deg) to her left (about +35 deg)."""
+    capture = cv2.VideoCapture(str(VIDEOS / "head-pose-face-detection-female.gif"))
+    yaws = []
+    with MediaPipeLandmarker(LandmarksConfig(), model_path, video=True) as detector:
+        for index in range(23):
+            ok, frame = capture.read()
+            if not ok:
+                break
+            yaws.append(center_ce_of(detector.detect(frame, index / 12.0).driver))
+    capture.release()
+    assert len(yaws) == 23
+    assert min(yaws) < -45.0 and max(yaws) > 25.0
+    assert int(np.argmin(yaws)) < int(np.argmax(yaws))

@@ -130,14 +130,19 @@ def yaw_by_model(
 
 
 def read_image(path: Path) -> npt.NDArray[np.uint8]:
-    """An image file as uint8 (grayscale, BGR or BGRA kept as stored); SourceError if unusable."""
+    """An image file as uint8 grayscale or BGR, EXIF orientation applied; SourceError if unusable.
+
+    16-bit images are scaled to 8 bits; an alpha channel is dropped.
+    """
     import cv2
 
     if not path.exists():
         raise SourceError(f"{path}: file not found")
     if not path.is_file():
         raise SourceError(f"{path}: not a regular file")
-    decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    # ANYCOLOR | ANYDEPTH keeps grayscale and 16-bit data and applies the EXIF orientation
+    # (IMREAD_UNCHANGED would ignore it and hand MediaPipe a sideways phone photo).
+    decoded = cv2.imread(str(path), cv2.IMREAD_ANYCOLOR | cv2.IMREAD_ANYDEPTH)
     if decoded is None or decoded.size == 0:
         raise SourceError(f"{path}: cannot decode as an image (corrupt or unsupported format)")
     image: npt.NDArray[Any] = np.asarray(decoded)

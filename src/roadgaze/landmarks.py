@@ -230,19 +230,45 @@ def features_from_landmarks(
     )
 
 
-def choose_driver(faces: Sequence[FaceFeatures], rule: str) -> int | None:
+DRIVER_SWITCH_AREA_RATIO = 1.25
+"""In a stream, the "largest" rule moves to another face only when that face's box is this much
+larger than the current driver's; faces of similar size would otherwise swap from frame to frame."""
+DRIVER_MATCH_IOU = 0.3
+"""Box overlap above which a face in a new frame is taken to be the previous frame's driver."""
+
+
+def _area(face: FaceFeatures) -> float:
+    return (face.box_px[2] - face.box_px[0]) * (face.box_px[3] - face.box_px[1])
+
+
+def choose_driver(
+    faces: Sequence[FaceFeatures],
+    rule: str,
+    previous_box_px: tuple[float, float, float, float] | None = None,
+) -> int | None:
     """Index of the driver among `faces` under `rule`, None when there is no face.
 
     "largest": the face with the largest bounding-box area (default; the driver sits nearest the
     camera). "left" / "right": the face whose box centre is furthest to the image's left / right,
     i.e. the driver sits on that side of the picture as the camera sees it (for a camera facing a
     left-hand-drive driver from the dashboard centre, the driver appears on the image's right).
+    `previous_box_px` (streams): the previous frame's driver box; under "largest" that face stays
+    the driver unless another is `DRIVER_SWITCH_AREA_RATIO` times larger.
     """
     if not faces:
         return None
     if rule == "largest":
-        areas = [(f.box_px[2] - f.box_px[0]) * (f.box_px[3] - f.box_px[1]) for f in faces]
-        return int(np.argmax(areas))
+        areas = [_area(f) for f in faces]
+        best = int(np.argmax(areas))
+        if previous_box_px is not None:
+            overlaps = [_box_iou(f.box_px, previous_box_px) for f in faces]
+            kept = int(np.argmax(overlaps))
+            if (
+                overlaps[kept] >= DRIVER_MATCH_IOU
+                and areas[best] < DRIVER_SWITCH_AREA_RATIO * areas[kept]
+            ):
+                return kept
+        return best
     centers = [0.5 * (f.box_px[0] + f.box_px[2]) for f in faces]
     if rule == "left":
         return int(np.argmin(centers))
@@ -405,6 +431,7 @@ class MediaPipeLandmarker:
         self._choice = choice
         self._last_ms = -1
         self._last_t_s = -math.inf
+        self._driver_box_px: tuple[float, float, float, float] | None = None
         mode = vision.RunningMode.VIDEO if video else vision.RunningMode.IMAGE
         options = vision.FaceLandmarkerOptions(
             base_options=BaseOptions(model_asset_path=str(model_path)),
@@ -464,7 +491,11 @@ class MediaPipeLandmarker:
                 self._mirror_landmarker, np.ascontiguousarray(rgb[:, ::-1]), timestamp_ms
             )
             faces = merge_mirrored(faces, mirrored, rgb.shape[1])
-        return Detection(faces=tuple(faces), driver_index=choose_driver(faces, self._config.driver))
+        if not self._video:
+            return Detection(tuple(faces), choose_driver(faces, self._config.driver))
+        driver_index = choose_driver(faces, self._config.driver, self._driver_box_px)
+        self._driver_box_px = None if driver_index is None else faces[driver_index].box_px
+        return Detection(faces=tuple(faces), driver_index=driver_index)
 
     def _run(
         self, landmarker: Any, rgb: npt.NDArray[np.uint8], timestamp_ms: int | None

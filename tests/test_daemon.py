@@ -25,6 +25,7 @@ import zenoh
 from roadgaze.capture import SourceStatus
 from roadgaze.config import Config
 from roadgaze.daemon import MonitorPublisher
+from roadgaze.logs import setup_logging
 from roadgaze.transport import (
     AlertMessage,
     Keys,
@@ -48,6 +49,12 @@ ENV = {**os.environ, "PYTHONPATH": str(REPO / "src"), "GLOG_minloglevel": "2"}
 needs_data = pytest.mark.skipif(
     not FRONTAL.is_file(), reason=f"Pointing'04 stills not found under {DATA} (evaluation data)"
 )
+
+
+@pytest.fixture(autouse=True)
+def fresh_log_handler() -> None:
+    """Log to this test's stderr (an earlier in-process CLI test may have left a closed one)."""
+    setup_logging()
 
 
 @dataclass

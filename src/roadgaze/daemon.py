@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 import signal
 import threading
 import time
@@ -41,6 +42,7 @@ if TYPE_CHECKING:
 log = logging.getLogger("roadgaze.daemon")
 
 Status = Literal["starting", "running", "degraded", "stopping", "stopped"]
+LINK_CHECK_PERIOD_S = 1.0
 
 
 class MessageLink(Protocol):
@@ -87,6 +89,8 @@ class MonitorPublisher:
         """Every alert raised, in order (bounded by what one run can raise: a few per glance)."""
         self.last_extras: dict[str, Any] = {}
         """The monitor's view of the last sample, for frame records (JSONL extras)."""
+        self._link_connected: bool | None = None
+        self._link_checked_at = -math.inf
 
     def _speed(self) -> tuple[float | None, Literal["none", "waiting", "fresh", "stale"]]:
         speed = None if self.link is None else self.link.speed
@@ -134,6 +138,21 @@ class MonitorPublisher:
         self._yaw_seq += 1
         for alert in alerts:
             self._publish_alert(alert, wall_time)
+        self._watch_link()
+
+    def _watch_link(self) -> None:
+        """Log when the Zenoh link comes or goes (checked at most once a second)."""
+        now = time.monotonic()
+        if self.link is None or now - self._link_checked_at < LINK_CHECK_PERIOD_S:
+            return
+        self._link_checked_at = now
+        connected = self.link.status().connected
+        if connected != self._link_connected:
+            if connected:
+                log.info("zenoh connected: publishing to subscribers again")
+            else:
+                log.warning("zenoh not connected: monitoring goes on, state is degraded")
+            self._link_connected = connected
 
     def _publish_alert(self, alert: Alert, wall_time: float) -> None:
         self.alerts.append(alert)

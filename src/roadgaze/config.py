@@ -57,6 +57,9 @@ class LandmarksConfig(_Section):
     min_tracking_confidence: float = Field(default=0.5, ge=0, le=1)
     driver: Literal["largest", "left", "right"] = "largest"
     """Which face is the driver: the largest, or the one on the image's left or right side."""
+    mirror_average: bool = False
+    """Also run the mirrored image and average the two measurements: exactly mirror-symmetric
+    yaw and slightly better accuracy (docs/landmarks.md) for twice the landmarker time."""
 
 
 class CaptureConfig(_Section):
@@ -75,7 +78,7 @@ class SmoothingConfig(_Section):
 
     measurement_std_deg: float = Field(default=3.0, gt=0)
     """Standard deviation of one raw Center-CE measurement."""
-    acceleration_std_dps2: float = Field(default=400.0, gt=0)
+    acceleration_std_dps2: float = Field(default=200.0, gt=0)
     """White-noise yaw acceleration driving the constant-velocity model."""
     gate_sigma: float = Field(default=4.0, gt=0)
     """Reject a measurement whose innovation exceeds this many standard deviations."""
@@ -83,7 +86,7 @@ class SmoothingConfig(_Section):
     """After this many consecutive rejections, the track is re-initialised on the measurement."""
     reinit_gap_s: float = Field(default=1.5, gt=0)
     """After this long without a face the track is dropped and restarts on the next face."""
-    initial_std_deg: float = Field(default=10.0, gt=0)
+    initial_std_deg: float = Field(default=3.0, gt=0)
     initial_rate_std_dps: float = Field(default=60.0, gt=0)
 
 
@@ -102,8 +105,9 @@ class MonitorConfig(_Section):
     vats_threshold_s: float = Field(default=10.0, gt=0)
     vats_rearm_s: float = Field(default=2.0, ge=0)
     unavailable_s: float = Field(default=2.0, gt=0)
-    turn_away_deg: float = Field(default=50.0, gt=0)
-    """A face lost while |yaw - neutral| exceeded this counts as turned away, not unavailable."""
+    turn_away_deg: float | None = Field(default=None, gt=0)
+    """A face lost while |yaw - neutral| exceeded this counts as turned away, not unavailable;
+    None: a face lost while the head was off road (past the road-ahead limit) is turned away."""
     min_speed_kmh: float = Field(default=20.0, ge=0)
 
 
@@ -118,8 +122,13 @@ class ZenohConfig(_Section):
     """A Zenoh JSON5 config file; when set it is the base and the fields above override it."""
     vehicle_id: str = Field(default="car-0", pattern=r"^[A-Za-z0-9_.-]+$")
     prefix: str = "vehicle/{vehicle_id}/dms"
-    speed_key: str | None = None
-    """Key expression of the speed input, e.g. 'vehicle/{vehicle_id}/speed'; None: always moving."""
+    speed_key: str = "vehicle/{vehicle_id}/speed"
+    """Key expression of the speed input; '' for none. Without a (fresh) speed: taken as moving."""
+    speed_stale_s: float = Field(default=5.0, gt=0)
+    """A speed older than this (wall time) is forgotten and the vehicle taken as moving again."""
+    reconnect_initial_s: float = Field(default=0.5, gt=0)
+    """First delay before re-opening a session that could not be opened (client mode)."""
+    reconnect_max_s: float = Field(default=10.0, gt=0)
 
 
 class LoggingConfig(_Section):

@@ -1,0 +1,117 @@
+"""`roadgaze eval DATASET_DIR`: accuracy of every yaw model and of MediaPipe's own yaw."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+from typing import Any
+
+from roadgaze.commands import common_options, config_from_args
+
+ORDER = 40
+
+
+def register(subparsers: Any) -> None:
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        "eval",
+        parents=[common_options()],
+        help="score the yaw models against a data set's ground_truth.csv",
+        description="Estimate yaw on every image listed in DATASET_DIR/ground_truth.csv "
+        "(columns file,yaw_deg[,pitch_deg]; rows with |pitch_deg| = 90 are skipped) and print "
+        "MAE, RMSE, median error and detection rate per model and for MediaPipe's own yaw, for "
+        "|yaw| <= 60 deg, for all rows, and per 15 deg bin.",
+    )
+    parser.add_argument("dataset", type=Path, metavar="DATASET_DIR")
+    parser.add_argument("--report", type=Path, metavar="JSON", help="write all figures as JSON")
+    parser.add_argument(
+        "--predictions", type=Path, metavar="CSV", help="write per-image estimates as CSV"
+    )
+    parser.add_argument(
+        "--plot", type=Path, metavar="PNG", help="plot estimated vs true yaw per model"
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=min(2, os.cpu_count() or 1),
+        metavar="N",
+        help="worker processes, each with its own landmarker (default: up to 2)",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    parser.add_argument(
+        "--refit",
+        action="store_true",
+        help="also fit alpha/beta/gamma globally (all images together) and report beside the "
+        "paper's constants; the paper's constants stay the ones used for every other figure",
+    )
+    parser.add_argument(
+        "--compare-landmarks",
+        type=Path,
+        metavar="MD",
+        help="score the candidate landmark choices (docs/landmarks.md) and write a Markdown "
+        "table here",
+    )
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    from roadgaze.evaluation import (
+        compare_landmark_choices,
+        estimate_images,
+        evaluate,
+        format_landmark_comparison,
+        format_report,
+        load_ground_truth,
+        refit_constants,
+        save_plot,
+        write_predictions,
+        write_report,
+    )
+    from roadgaze.geometry import FaceModelConstants
+    from roadgaze.landmarks import CANDIDATE_CHOICES
+    from roadgaze.model_store import resolve_model
+
+    config = config_from_args(args)
+    truths, skipped = load_ground_truth(args.dataset)
+    geometry = config.geometry
+    constants = FaceModelConstants(
+        geometry.alpha, geometry.beta, geometry.gamma_c, geometry.gamma_b
+    )
+    model_path = resolve_model(config.model)
+    jobs = [(args.dataset / truth.file, truth.file) for truth in truths]
+    estimates = list(
+        estimate_images(
+            jobs,
+            config.landmarks,
+            model_path,
+            constants,
+            workers=max(1, args.workers),
+            progress=not args.no_progress,
+            description="eval",
+        )
+    )
+    report = evaluate(str(args.dataset), truths, estimates, skipped, constants)
+    if args.refit:
+        report = replace(report, refit=refit_constants(truths, estimates, constants))
+    print(format_report(report))
+    if args.predictions is not None:
+        write_predictions(args.predictions, estimates)
+        print(f"wrote {args.predictions}")
+    if args.report is not None:
+        write_report(args.report, report)
+        print(f"wrote {args.report}")
+    if args.plot is not None:
+        save_plot(args.plot, truths, estimates)
+        print(f"wrote {args.plot}")
+    if args.compare_landmarks is not None:
+        table = format_landmark_comparison(
+            compare_landmark_choices(truths, estimates, CANDIDATE_CHOICES, constants)
+        )
+        args.compare_landmarks.parent.mkdir(parents=True, exist_ok=True)
+        args.compare_landmarks.write_text(table + "\n", encoding="utf-8")
+        print()
+        print(table)
+        print(f"wrote {args.compare_landmarks}")
+    return 0

@@ -1,0 +1,214 @@
+"""`roadgaze replay VIDEO --out frames.jsonl`: run the pipeline over a recording, write per frame.
+
+Structure for extension: `add_arguments` declares the options, `build_sinks` turns them into
+pipeline sinks (in the order they see each sample), `run` opens source and detector, runs the
+loop and reports. A new output (a Zenoh publisher, a monitor) is one option in `add_arguments`
+and one sink in `build_sinks`; a monitor sink placed before the writers can add fields to every
+record through the writers' `extras`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from contextlib import ExitStack
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from roadgaze.commands import common_options, config_from_args
+
+if TYPE_CHECKING:
+    from roadgaze.capture import SourceInfo
+    from roadgaze.config import Config
+    from roadgaze.outputs import Extras
+    from roadgaze.pipeline import RunSummary, Sink
+    from roadgaze.types import YawSample
+
+ORDER = 30
+
+
+def register(subparsers: Any) -> None:
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        "replay",
+        parents=[common_options()],
+        help="run the yaw pipeline over a video and write one record per frame",
+        description="Run capture -> landmarks -> Center-CE yaw -> Kalman smoother over a video "
+        "file (or image folder, or camera) and write one JSON object per frame. A progress bar "
+        "with fps and ETA goes to stderr.",
+    )
+    add_arguments(parser)
+    parser.set_defaults(handler=run)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "source", metavar="VIDEO", help="video file, image folder, /dev/videoN or camera index"
+    )
+    parser.add_argument(
+        "--out", metavar="FILE", help="JSON-lines output, one object per frame ('-' for stdout)"
+    )
+    parser.add_argument("--csv", type=Path, metavar="FILE", help="the same records as CSV")
+    parser.add_argument(
+        "--annotate",
+        type=Path,
+        metavar="FILE",
+        help="write the video with face boundaries, centre line, yaw gauge and state (.mp4)",
+    )
+    parser.add_argument(
+        "--plot", type=Path, metavar="FILE", help="PNG of raw and smoothed yaw over time"
+    )
+    parser.add_argument(
+        "--realtime",
+        action="store_true",
+        help="pace the replay at the source's own rate (default: as fast as possible)",
+    )
+    parser.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_monitor_arguments(parser)
+
+
+# --- Monitor and Zenoh publishing (roadgaze.monitor / roadgaze.daemon) -------------------------
+
+
+def add_monitor_arguments(parser: argparse.ArgumentParser) -> None:
+    """--publish and the Zenoh options; the monitor itself always runs and fills the records."""
+    from roadgaze.transport import add_zenoh_options
+
+    parser.add_argument(
+        "--publish",
+        action="store_true",
+        help="publish yaw, alerts, liveliness and state on Zenoh, stamped with the video's time",
+    )
+    add_zenoh_options(parser)
+
+
+def monitor_config(args: argparse.Namespace, config: Config) -> Config:
+    from roadgaze.transport import zenoh_config_from_args
+
+    return config.model_copy(update={"zenoh": zenoh_config_from_args(config.zenoh, args)})
+
+
+def report_alerts(args: argparse.Namespace, alerts: list[Any]) -> None:
+    for alert in alerts:
+        print(
+            f"replay {args.source}: alert {alert.kind.value} {alert.level.value} "
+            f"at t={alert.t_s:.2f}s (off road {alert.off_road_s:.2f}s, "
+            f"window {alert.window_off_road_s:.2f}s)",
+            file=sys.stderr,
+        )
+
+
+# --- end of monitor and Zenoh publishing -------------------------------------------------------
+
+
+class ReplayStats:
+    """Counts faces and the range of raw and smoothed yaw, for the closing summary line."""
+
+    def __init__(self) -> None:
+        self.frames = 0
+        self.faces = 0
+        self.raw_min_deg = math.inf
+        self.raw_max_deg = -math.inf
+        self.smoothed_min_deg = math.inf
+        self.smoothed_max_deg = -math.inf
+
+    def on_sample(self, sample: YawSample) -> None:
+        self.frames += 1
+        self.faces += sample.face
+        if sample.yaw_raw_deg is not None:
+            self.raw_min_deg = min(self.raw_min_deg, sample.yaw_raw_deg)
+            self.raw_max_deg = max(self.raw_max_deg, sample.yaw_raw_deg)
+        if sample.yaw_deg is not None:
+            self.smoothed_min_deg = min(self.smoothed_min_deg, sample.yaw_deg)
+            self.smoothed_max_deg = max(self.smoothed_max_deg, sample.yaw_deg)
+
+    def close(self) -> None:
+        return None
+
+    def describe(self) -> str:
+        rate = 100.0 * self.faces / self.frames if self.frames else 0.0
+        text = f"{self.frames} frames, face in {self.faces} ({rate:.0f}%)"
+        if self.raw_min_deg <= self.raw_max_deg:
+            text += f", raw yaw {self.raw_min_deg:+.1f}..{self.raw_max_deg:+.1f} deg"
+        if self.smoothed_min_deg <= self.smoothed_max_deg:
+            text += f", smoothed {self.smoothed_min_deg:+.1f}..{self.smoothed_max_deg:+.1f} deg"
+        return text
+
+
+def record_extras(args: argparse.Namespace, config: Config) -> list[Extras]:
+    """Extra per-frame fields for the JSONL/CSV records (none yet; e.g. a monitor's state)."""
+    return []
+
+
+def build_sinks(
+    args: argparse.Namespace,
+    config: Config,
+    info: SourceInfo,
+    stack: ExitStack,
+    extras: list[Extras] | None = None,
+) -> list[Sink]:
+    """The sinks the options ask for, each registered on `stack` so it is closed at the end."""
+    from roadgaze.outputs import AnnotatedVideoWriter, CsvWriter, JsonlWriter, ProgressBar, YawPlot
+
+    extras = extras if extras is not None else record_extras(args, config)
+    sinks: list[Sink] = []
+    if args.out is not None:
+        target = sys.stdout if args.out == "-" else Path(args.out)
+        sinks.append(stack.enter_context(JsonlWriter(target, extras)))
+    if args.csv is not None:
+        sinks.append(stack.enter_context(CsvWriter(args.csv, extras)))
+    if args.plot is not None:
+        sinks.append(stack.enter_context(YawPlot(args.plot, title=Path(info.name).name)))
+    if args.annotate is not None:
+        sinks.append(stack.enter_context(AnnotatedVideoWriter(args.annotate, info.fps or 30.0)))
+    if not args.no_progress:
+        total = info.frame_count
+        if args.max_frames is not None and total is not None:
+            total = min(total, args.max_frames)
+        sinks.append(stack.enter_context(ProgressBar(total, description="replay")))
+    return sinks
+
+
+def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) -> None:
+    print(
+        f"replay {args.source}: {stats.describe()}; {summary.fps:.1f} fps",
+        file=sys.stderr,
+    )
+    status = summary.source_status
+    if status.message:
+        print(f"replay {args.source}: {status.message}", file=sys.stderr)
+    if status.frames_dropped:
+        print(f"replay {args.source}: {status.frames_dropped} frames dropped", file=sys.stderr)
+    for name in ("out", "csv", "plot", "annotate"):
+        value = getattr(args, name)
+        if value is not None and value != "-":
+            print(f"wrote {value}", file=sys.stderr)
+
+
+def run(args: argparse.Namespace) -> int:
+    from roadgaze.capture import open_source
+    from roadgaze.daemon import publishing_sink
+    from roadgaze.errors import ConfigError
+    from roadgaze.pipeline import Pipeline, create_detector
+
+    if args.max_frames is not None and args.max_frames < 1:
+        raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
+    config = monitor_config(args, config_from_args(args))
+    stats = ReplayStats()
+    with ExitStack() as stack:
+        source = stack.enter_context(open_source(args.source, config))
+        detector = create_detector(config)
+        stack.callback(detector.close)
+        monitor = stack.enter_context(publishing_sink(config, args.source, args.publish))
+        extras = [*record_extras(args, config), monitor.extras]
+        sinks: list[Sink] = [
+            stats,
+            monitor,
+            *build_sinks(args, config, source.info, stack, extras),
+        ]
+        pipeline = Pipeline.from_config(config, detector)
+        summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
+    report(args, summary, stats)
+    report_alerts(args, monitor.alerts)
+    return 0

@@ -1,0 +1,47 @@
+"""`roadgaze run`: the monitoring daemon (camera or file -> yaw -> monitor -> Zenoh)."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from roadgaze.commands import common_options, config_from_args
+
+ORDER = 50
+
+
+def register(subparsers: Any) -> None:
+    from roadgaze.transport import add_zenoh_options
+
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        "run",
+        parents=[common_options()],
+        help="run the monitoring daemon and publish yaw, alerts, liveliness and state on Zenoh",
+        description="Read a camera (/dev/videoN or an index) or a video file (paced at its own "
+        "rate), estimate head yaw per frame, run the inattention monitor and publish on Zenoh "
+        "under vehicle/<id>/dms/. SIGINT/SIGTERM finish the current frame, publish a final state, "
+        "undeclare and exit 0. A lost camera and an unreachable Zenoh peer are retried and "
+        "reported in the state (degraded), never fatal.",
+    )
+    parser.add_argument(
+        "--source", required=True, metavar="FILE|/dev/videoN|N", help="video file or camera"
+    )
+    parser.add_argument(
+        "--no-realtime",
+        action="store_true",
+        help="process a file as fast as possible instead of at its own frame rate",
+    )
+    add_zenoh_options(parser)
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from roadgaze.daemon import run_daemon
+    from roadgaze.logs import setup_logging
+    from roadgaze.transport import zenoh_config_from_args
+
+    config = config_from_args(args)
+    config = config.model_copy(update={"zenoh": zenoh_config_from_args(config.zenoh, args)})
+    if args.log_level is None and not args.log_json:
+        setup_logging(config.logging.level, config.logging.json_format)
+    return run_daemon(config, args.source, realtime=not args.no_realtime)

@@ -1,0 +1,82 @@
+"""The schema and listen commands (their Zenoh round trips: test_transport, test_daemon)."""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections.abc import Iterator
+
+import jsonschema
+import pytest
+
+from roadgaze.cli import main
+from roadgaze.commands.listen import _vehicle_of, format_pretty
+
+
+@pytest.fixture(autouse=True)
+def restore_logging() -> Iterator[None]:
+    """`main()` points roadgaze's log handler at the captured stderr; undo it afterwards."""
+    logger = logging.getLogger("roadgaze")
+    handlers, level, propagate = list(logger.handlers), logger.level, logger.propagate
+    yield
+    logger.handlers[:] = handlers
+    logger.setLevel(level)
+    logger.propagate = propagate
+
+
+def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["schema"]) == 0
+    schemas = json.loads(capsys.readouterr().out)
+    assert sorted(schemas) == ["alert", "state", "yaw"]
+    for schema in schemas.values():
+        jsonschema.Draft202012Validator.check_schema(schema)
+    required = set(schemas["alert"]["required"])
+    assert {"schema", "vehicle_id", "seq", "kind", "level", "t_s", "wall_time"} <= required
+    assert {"yaw_deg", "off_road_s"} <= set(schemas["alert"]["properties"])
+    yaw_fields = {"schema", "vehicle_id", "seq", "t_s", "frame", "face", "yaw_deg", "yaw_raw_deg"}
+    assert yaw_fields | {"on_road"} <= set(schemas["yaw"]["properties"])
+    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/1"
+
+
+def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["schema", "yaw"]) == 0
+    assert json.loads(capsys.readouterr().out)["title"] == "YawMessage"
+
+
+@pytest.mark.parametrize(
+    ("kind", "payload", "expected"),
+    [
+        ("alive", {"alive": False}, "alive  car-1 left"),
+        (
+            "alert",
+            {
+                "seq": 3,
+                "kind": "vats",
+                "level": "warning",
+                "t_s": 15.0,
+                "off_road_s": 0.0,
+                "window_off_road_s": 10.0,
+                "yaw_deg": None,
+            },
+            "ALERT  car-1 #3 vats warning t=15.00s off_road=0.00s window=10.00s no face",
+        ),
+        (
+            "yaw",
+            {"seq": 9, "t_s": 0.3, "yaw_deg": -12.34, "gaze": "on_road"},
+            "yaw    car-1 #9 t=0.30s   -12.3° on_road",
+        ),
+        ("state", None, "state  car-1 undecodable payload: garbage"),
+    ],
+)
+def test_listen_pretty_lines(kind: str, payload: dict[str, object] | None, expected: str) -> None:
+    assert format_pretty(kind, "car-1", payload, "garbage") == expected
+
+
+def test_listen_finds_the_vehicle_in_the_key() -> None:
+    assert _vehicle_of("vehicle/car-9/dms/alert", "vehicle/{vehicle_id}/dms") == "car-9"
+    assert _vehicle_of("fleet/x/alert", "fleet/dms") == "?"
+
+
+def test_bad_zenoh_option_is_a_one_line_error(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["listen", "--vehicle-id", "bad id!", "--timeout", "0.1"]) == 2
+    assert "vehicle_id" in capsys.readouterr().err

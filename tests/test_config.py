@@ -1,0 +1,103 @@
+"""Configuration precedence and the one-line errors for bad values."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from roadgaze.config import Config, load_config, parse_overrides
+from roadgaze.errors import ConfigError
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def test_defaults_are_the_documented_ones() -> None:
+    config = load_config(environ={})
+    assert config.geometry.model == "center_ce"
+    assert config.geometry.beta == 1.25
+    assert config.monitor.long_distraction_s == 3.0
+    assert config.monitor.min_speed_kmh == 20.0
+    assert config.zenoh.multicast_scouting is False
+    assert all("127.0.0.1" in endpoint for endpoint in config.zenoh.listen)
+
+
+def test_file_then_environment_then_overrides(tmp_path: Path) -> None:
+    path = tmp_path / "roadgaze.toml"
+    path.write_text(
+        "[monitor]\nmin_speed_kmh = 30\nlong_distraction_s = 2.5\n[zenoh]\nvehicle_id = 'a'\n"
+    )
+    environ = {"ROADGAZE__MONITOR__MIN_SPEED_KMH": "40", "ROADGAZE__ZENOH__VEHICLE_ID": "b"}
+    config = load_config(path, {"zenoh.vehicle_id": "c"}, environ)
+    assert config.monitor.long_distraction_s == 2.5  # file
+    assert config.monitor.min_speed_kmh == 40.0  # environment beats file
+    assert config.zenoh.vehicle_id == "c"  # override beats environment
+
+
+def test_override_values_parse_as_toml_values() -> None:
+    config = load_config(
+        overrides=parse_overrides(
+            ["zenoh.connect=['tcp/127.0.0.1:7447']", "logging.json_format=true", "model.path=/x"]
+        ),
+        environ={},
+    )
+    assert config.zenoh.connect == ["tcp/127.0.0.1:7447"]
+    assert config.logging.json_format is True
+    assert config.model.path == Path("/x")
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        ({"monitor.min_speed_kmh": "-5"}, "monitor.min_speed_kmh"),
+        ({"geometry.model": "sphere"}, "geometry.model"),
+        ({"geometry.beta": "0.5"}, "geometry.beta"),
+        ({"monitor.no_such_field": "1"}, "no_such_field"),
+        ({"nosection.field": "1"}, "unknown section 'nosection'"),
+        ({"toplevel": "1"}, "expected 'section.field'"),
+        ({"zenoh.vehicle_id": "'has space'"}, "zenoh.vehicle_id"),
+    ],
+)
+def test_bad_values_raise_config_error_naming_the_field(
+    overrides: dict[str, str], message: str
+) -> None:
+    with pytest.raises(ConfigError, match=message) as caught:
+        load_config(overrides=overrides, environ={})
+    assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [("[monitor\n", "not valid TOML"), ("[monitor]\nunknown = 1\n", "monitor.unknown")],
+)
+def test_bad_files_raise_config_error(tmp_path: Path, content: str, message: str) -> None:
+    path = tmp_path / "bad.toml"
+    path.write_text(content)
+    with pytest.raises(ConfigError, match=message):
+        load_config(path, environ={})
+
+
+def test_missing_file_raises_config_error(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="not found"):
+        load_config(tmp_path / "absent.toml", environ={})
+
+
+def test_bad_set_syntax_is_reported() -> None:
+    with pytest.raises(ConfigError, match=r"section\.field=value"):
+        parse_overrides(["monitor.min_speed_kmh"])
+
+
+def test_shipped_default_config_loads_and_equals_the_built_in_defaults() -> None:
+    shipped = load_config(REPO / "config" / "roadgaze.toml", environ={})
+    assert shipped == Config()
+
+
+def test_shipped_default_config_mentions_every_field() -> None:
+    text = (REPO / "config" / "roadgaze.toml").read_text()
+    for section_name, section in Config.model_fields.items():
+        assert f"[{section_name}]" in text
+        assert section.annotation is not None
+        for field in section.annotation.model_fields:
+            assert f"{field} =" in text, (
+                f"config/roadgaze.toml does not mention {section_name}.{field}"
+            )

@@ -1,0 +1,516 @@
+"""The monitor+publisher sink, `roadgaze run` and `roadgaze replay --publish` end to end.
+
+End-to-end tests use real MediaPipe on clips built from Pointing'04 stills (Person01, frontal and
+45 deg), a Python router session standing in for zenohd on a free loopback port, and the daemon
+in a subprocess that is always terminated.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import pytest
+import zenoh
+
+from roadgaze.capture import SourceStatus
+from roadgaze.config import Config
+from roadgaze.daemon import MonitorPublisher
+from roadgaze.logs import setup_logging
+from roadgaze.transport import (
+    AlertMessage,
+    Keys,
+    SpeedInput,
+    TransportStatus,
+    YawMessage,
+    json_schemas,
+)
+from roadgaze.types import YawSample
+from zenoh_helpers import LineReader, endpoint, free_port, router, stop_process, wait_for
+
+REPO = Path(__file__).resolve().parents[1]
+DATA = REPO.parent / "shared" / "data"
+STILLS = DATA / "pointing04-dev" / "images" / "Person01"
+FRONTAL = STILLS / "person01146+0+0.jpg"
+SIDE_45 = STILLS / "person01143+0-45.jpg"
+CLIP_FPS = 15
+SCHEMAS = json_schemas()
+ENV = {**os.environ, "PYTHONPATH": str(REPO / "src"), "GLOG_minloglevel": "2"}
+
+needs_data = pytest.mark.skipif(
+    not FRONTAL.is_file(), reason=f"Pointing'04 stills not found under {DATA} (evaluation data)"
+)
+
+
+@pytest.fixture(autouse=True)
+def fresh_log_handler() -> None:
+    """Log to this test's stderr (an earlier in-process CLI test may have left a closed one)."""
+    setup_logging()
+
+
+@dataclass
+class FakeLink:
+    yaw: list[YawMessage] = field(default_factory=list)
+    alerts: list[AlertMessage] = field(default_factory=list)
+    connected: bool = True
+    speed: SpeedInput | None = None
+
+    def publish_yaw(self, message: YawMessage) -> None:
+        self.yaw.append(message)
+
+    def publish_alert(self, message: AlertMessage) -> None:
+        self.alerts.append(message)
+
+    def status(self) -> TransportStatus:
+        return TransportStatus(mode="peer", session_open=True, connected=self.connected)
+
+
+def sample(t_s: float, yaw_deg: float | None) -> YawSample:
+    face = yaw_deg is not None
+    return YawSample(t_s, round(t_s * 30), face, yaw_deg, yaw_deg, 0.0, 1.0, n_faces=int(face))
+
+
+def test_sink_publishes_every_sample_and_each_alert_in_order() -> None:
+    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
+    link = FakeLink()
+    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), link, "test", lambda: 1e9)
+    for frame in range(300):  # 1 s ahead, 4 s at 45 deg, 5 s ahead
+        t_s = frame / 30
+        sink.on_sample(sample(t_s, 45.0 if 1.0 <= t_s < 5.0 else 0.0))
+    assert [m.seq for m in link.yaw] == list(range(300))
+    assert [(m.seq, m.kind, m.level) for m in link.alerts] == [
+        (0, "long_distraction", "warning"),
+        (1, "cleared", "info"),
+    ]
+    assert link.alerts[0].t_s == pytest.approx(4.0, abs=1 / 30)
+    assert link.alerts[1].clears == ["long_distraction"]
+    assert link.yaw[40].on_road is False and link.yaw[40].gaze == "off_road"
+    assert sink.last_extras["on_road"] is True
+    jsonschema.validate(json.loads(link.yaw[0].to_json_bytes()), SCHEMAS["yaw"])
+    jsonschema.validate(json.loads(link.alerts[0].to_json_bytes()), SCHEMAS["alert"])
+
+
+def test_state_is_degraded_when_the_camera_or_zenoh_is_lost() -> None:
+    config = Config()
+    link = FakeLink()
+    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), link, "/dev/video0")
+    assert sink.state_message().status == "starting"
+    sink.on_sample(sample(0.0, 0.0))
+    assert (sink.state_message().status, sink.state_message().problems) == ("running", [])
+
+    class LostCamera:
+        status = SourceStatus(connected=False, reconnects=2, message="camera 0 lost; reconnecting")
+
+    sink.source = LostCamera()  # type: ignore[assignment]
+    state = sink.state_message()
+    assert state.status == "degraded"
+    assert state.problems == ["camera 0 lost; reconnecting"]
+    assert (state.source_status, state.camera_reopens) == ("reconnecting", 2)
+    sink.source = None
+    link.connected = False
+    assert sink.state_message().problems == ["zenoh not connected"]
+
+
+def write_clip(path: Path, segments: list[tuple[Path, float]]) -> Path:
+    import cv2
+
+    images = {still: cv2.imread(str(still)) for still, _ in segments}
+    height, width = next(iter(images.values())).shape[:2]
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), CLIP_FPS, (width, height))
+    try:
+        for still, seconds in segments:
+            for _ in range(round(seconds * CLIP_FPS)):
+                writer.write(images[still])
+    finally:
+        writer.release()
+    return path
+
+
+@pytest.fixture(scope="module")
+def glance_clip(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("clips")
+    return write_clip(folder / "glance.avi", [(FRONTAL, 4.0), (SIDE_45, 4.0), (FRONTAL, 4.0)])
+
+
+@pytest.fixture(scope="module")
+def vats_clip(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("clips")
+    segments = [(FRONTAL, 2.0)] + [(SIDE_45, 2.5), (FRONTAL, 1.0)] * 5 + [(FRONTAL, 1.0)]
+    return write_clip(folder / "vats.avi", segments)
+
+
+class Hub:
+    """A router session recording everything published under one vehicle's prefix."""
+
+    def __init__(self, session: zenoh.Session, vehicle_id: str) -> None:
+        self.session = session
+        self.prefix = f"vehicle/{vehicle_id}/dms"
+        self.messages: list[tuple[str, dict[str, Any]]] = []
+        self.alive: list[bool] = []
+        self._entities = [
+            session.declare_subscriber(f"{self.prefix}/**", self._on_sample),
+            session.liveliness().declare_subscriber(
+                f"{self.prefix}/alive",
+                lambda s: self.alive.append(s.kind == zenoh.SampleKind.PUT),
+                history=True,
+            ),
+        ]
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        kind = str(sample.key_expr).rsplit("/", 1)[-1]
+        self.messages.append((kind, json.loads(sample.payload.to_bytes())))
+
+    def of(self, kind: str) -> list[dict[str, Any]]:
+        return [payload for k, payload in list(self.messages) if k == kind]
+
+    def query_state(self) -> dict[str, Any] | None:
+        for reply in self.session.get(f"{self.prefix}/state", timeout=5.0):
+            if reply.ok is not None:
+                state: dict[str, Any] = json.loads(reply.ok.payload.to_bytes())
+                return state
+        return None
+
+    def close(self) -> None:
+        for entity in self._entities:
+            entity.undeclare()
+
+
+@pytest.fixture
+def hub() -> Iterator[tuple[Hub, int]]:
+    port = free_port()
+    with router(port) as session:
+        recorder = Hub(session, "e2e")
+        try:
+            yield recorder, port
+        finally:
+            recorder.close()
+
+
+def roadgaze(*args: str, **kwargs: Any) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [sys.executable, "-m", "roadgaze", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=ENV,
+        **kwargs,
+    )
+
+
+def replay_publish(clip: Path, port: int, out: Path) -> subprocess.CompletedProcess[str]:
+    process = roadgaze(
+        "replay",
+        str(clip),
+        "--publish",
+        "--vehicle-id",
+        "e2e",
+        "--zenoh-connect",
+        endpoint(port),
+        "--no-progress",
+        "--out",
+        str(out),
+    )
+    try:
+        stdout, stderr = process.communicate(timeout=180)
+    finally:
+        stop_process(process)
+    return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+
+
+@needs_data
+@pytest.mark.slow
+def test_replay_publish_one_long_distraction_three_seconds_into_the_glance(
+    glance_clip: Path, hub: tuple[Hub, int], tmp_path: Path
+) -> None:
+    recorder, port = hub
+    result = replay_publish(glance_clip, port, tmp_path / "frames.jsonl")
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert wait_for(lambda: len(recorder.of("alert")) >= 2, timeout_s=5.0)
+    alerts = recorder.of("alert")
+    for alert in alerts:
+        jsonschema.validate(alert, SCHEMAS["alert"])
+    assert [(a["kind"], a["level"]) for a in alerts] == [
+        ("long_distraction", "warning"),
+        ("cleared", "info"),
+    ]
+    print(f"long_distraction at t={alerts[0]['t_s']:.3f}s, cleared at t={alerts[1]['t_s']:.3f}s")
+    assert alerts[0]["t_s"] == pytest.approx(4.0 + 3.0, abs=0.5)
+    assert 8.0 <= alerts[1]["t_s"] <= 8.5
+    assert alerts[0]["vehicle_id"] == "e2e" and alerts[0]["yaw_deg"] > 25.0
+    yaws = recorder.of("yaw")
+    assert len(yaws) == 12 * CLIP_FPS
+    assert [y["seq"] for y in yaws] == list(range(len(yaws)))
+    jsonschema.validate(yaws[100], SCHEMAS["yaw"])
+    assert yaws[100]["on_road"] is False and yaws[30]["on_road"] is True
+    assert yaws[100]["t_s"] == pytest.approx(100 / CLIP_FPS, abs=1e-3)  # the video's timeline
+    records = [json.loads(line) for line in (tmp_path / "frames.jsonl").read_text().splitlines()]
+    assert [r["on_road"] for r in records[95:106]] == [False] * 11
+    assert sum(r["alerts"] == ["long_distraction:warning"] for r in records) == 1
+    assert recorder.alive[:1] == [True] and recorder.alive[-1] is False
+    assert recorder.of("state")[-1]["status"] == "stopped"
+
+
+@needs_data
+@pytest.mark.slow
+def test_replay_publish_five_short_glances_one_vats_no_long_distraction(
+    vats_clip: Path, hub: tuple[Hub, int], tmp_path: Path
+) -> None:
+    recorder, port = hub
+    result = replay_publish(vats_clip, port, tmp_path / "frames.jsonl")
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert wait_for(lambda: any(a["kind"] == "vats" for a in recorder.of("alert")), timeout_s=5.0)
+    kinds = [a["kind"] for a in recorder.of("alert")]
+    assert kinds.count("vats") == 1
+    assert "long_distraction" not in kinds
+    vats = next(a for a in recorder.of("alert") if a["kind"] == "vats")
+    print(f"vats at t={vats['t_s']:.3f}s, window {vats['window_off_road_s']:.2f}s")
+    # Four glances of 2.5 s (2.0-4.5, 5.5-8.0, 9.0-11.5, 12.5-15.0 s) make 10 s at t = 15.0 s.
+    assert vats["t_s"] == pytest.approx(15.0, abs=0.5)
+    assert vats["window_off_road_s"] >= 10.0
+
+
+def run_daemon_process(source: str, port: int, *extra: str) -> subprocess.Popen[str]:
+    return roadgaze(
+        "run",
+        "--source",
+        source,
+        "--vehicle-id",
+        "e2e",
+        "--zenoh-connect",
+        endpoint(port),
+        "--log-json",
+        *extra,
+    )
+
+
+@needs_data
+@pytest.mark.slow
+def test_daemon_sigterm_publishes_final_state_and_its_token_goes_away(
+    glance_clip: Path, hub: tuple[Hub, int]
+) -> None:
+    recorder, port = hub
+    daemon = run_daemon_process(str(glance_clip), port)
+    try:
+        assert wait_for(lambda: len(recorder.of("yaw")) >= 15, timeout_s=60.0)
+        assert recorder.alive == [True]
+        state = recorder.query_state()
+        assert state is not None
+        jsonschema.validate(state, SCHEMAS["state"])
+        assert state["status"] == "running" and state["frames"] >= 15
+        assert state["transport"]["connected"] is True
+        daemon.send_signal(signal.SIGTERM)
+        code = daemon.wait(timeout=20)
+        stderr = daemon.stderr.read() if daemon.stderr else ""
+    finally:
+        stop_process(daemon)
+    assert code == 0, stderr[-2000:]
+    assert wait_for(lambda: recorder.alive == [True, False], timeout_s=5.0)
+    final = recorder.of("state")[-1]
+    assert final["status"] == "stopped"
+    assert final["frames"] == len(recorder.of("yaw"))  # the final state counts every frame sent
+    logs = [json.loads(line) for line in stderr.splitlines() if line.startswith("{")]
+    assert any("SIGTERM received" in entry["message"] for entry in logs)
+
+
+@needs_data
+@pytest.mark.slow
+def test_daemon_keeps_monitoring_while_the_peer_is_unreachable(glance_clip: Path) -> None:
+    port = free_port()
+    daemon = run_daemon_process(str(glance_clip), port)
+    try:
+        assert daemon.stderr is not None
+        started = LineReader(daemon, daemon.stderr)
+        line = ""
+        while "roadgaze run: source" not in line:
+            line = started.next(60.0) or ""
+            assert line or daemon.poll() is None, "daemon did not start"
+        time.sleep(3.0)  # monitoring while nothing listens on the port
+        assert daemon.poll() is None
+        with router(port) as session:
+            recorder = Hub(session, "e2e")
+            try:
+                assert wait_for(lambda: len(recorder.of("yaw")) >= 5, timeout_s=30.0)
+                first_seq = recorder.of("yaw")[0]["seq"]
+                state = recorder.query_state()
+            finally:
+                recorder.close()
+        daemon.send_signal(signal.SIGTERM)
+        assert daemon.wait(timeout=20) == 0
+    finally:
+        stop_process(daemon)
+    print(f"first yaw received after the router came up: seq {first_seq}")
+    assert first_seq >= 15  # frames were processed (and counted) while nobody was reachable
+    assert state is not None and state["frames"] > first_seq
+
+
+@pytest.mark.slow
+def test_daemon_reports_an_unavailable_camera_and_stops_cleanly(hub: tuple[Hub, int]) -> None:
+    recorder, port = hub
+    daemon = run_daemon_process("/dev/video97", port, "--set", "capture.reconnect_max_s=0.5")
+    try:
+        assert wait_for(lambda: recorder.alive == [True], timeout_s=30.0)
+        assert wait_for(
+            lambda: ((recorder.query_state() or {}).get("camera_reopens") or 0) >= 2,
+            timeout_s=15.0,
+        )
+        state = recorder.query_state()
+        health = roadgaze(
+            "listen", "--query-state", "--vehicle-id", "e2e", "--zenoh-connect", endpoint(port)
+        )
+        try:
+            health_out, _ = health.communicate(timeout=60)
+        finally:
+            stop_process(health)
+        assert daemon.poll() is None
+        daemon.send_signal(signal.SIGTERM)
+        assert daemon.wait(timeout=20) == 0
+    finally:
+        stop_process(daemon)
+    assert state is not None
+    assert state["status"] == "degraded" and state["source_status"] == "unavailable"
+    assert "camera unavailable" in state["problems"][0]
+    assert state["frames"] == 0
+    assert health.returncode == 3  # answered, but degraded: the container health check fails
+    assert "status=degraded" in health_out
+    assert wait_for(lambda: recorder.alive == [True, False], timeout_s=5.0)
+
+
+def test_run_with_a_missing_file_is_one_line_error(tmp_path: Path) -> None:
+    process = roadgaze(
+        "run", "--source", str(tmp_path / "nope.avi"), "--zenoh-listen", "tcp/127.0.0.1:0"
+    )
+    try:
+        _, stderr = process.communicate(timeout=60)
+    finally:
+        stop_process(process)
+    assert process.returncode == 2
+    assert stderr.strip().splitlines()[-1].startswith("roadgaze run: error: no video file")
+
+
+class FakeCamera:
+    """A V4L2 stand-in: `frames` reads at about 30 fps, then reads fail (unplugged)."""
+
+    def __init__(self, image: Any, frames: int | None) -> None:
+        self.image, self.frames_left = image, frames
+
+    def isOpened(self) -> bool:  # noqa: N802 (OpenCV's name)
+        return True
+
+    def read(self) -> tuple[bool, Any]:
+        time.sleep(1 / 30)
+        if self.frames_left is not None:
+            if self.frames_left <= 0:
+                return False, None
+            self.frames_left -= 1
+        return True, self.image.copy()
+
+    def get(self, prop_id: int) -> float:
+        return 0.0
+
+    def set(self, prop_id: int, value: float) -> bool:
+        return True
+
+    def release(self) -> None:
+        return None
+
+
+class Unplugged(FakeCamera):
+    def isOpened(self) -> bool:  # noqa: N802
+        return False
+
+
+@needs_data
+@pytest.mark.slow
+def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
+    hub: tuple[Hub, int], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import threading
+
+    import cv2
+
+    import roadgaze.capture as capture
+    from roadgaze.daemon import StopFlag, run_daemon
+
+    recorder, port = hub
+    image = cv2.imread(str(FRONTAL))
+    # First plug: 60 frames then the camera vanishes; two failed re-opens; then it is back.
+    plugs = iter([FakeCamera(image, 60), Unplugged(image, 0), Unplugged(image, 0)])
+
+    def factory(device: int | str) -> FakeCamera:
+        return next(plugs, None) or FakeCamera(image, None)
+
+    def open_fake(spec: str, config: Config | None = None) -> capture.FrameSource:
+        assert config is not None
+        return capture.CameraSource(spec, config.capture, capture_factory=factory)
+
+    monkeypatch.setattr(capture, "open_source", open_fake)
+    config = Config.model_validate(
+        {
+            "zenoh": {"vehicle_id": "e2e", "connect": [endpoint(port)]},
+            "capture": {"reconnect_initial_s": 0.3, "reconnect_max_s": 1.0},
+        }
+    )
+    stop = StopFlag()
+    result: list[int] = []
+    thread = threading.Thread(
+        target=lambda: result.append(run_daemon(config, "/dev/video42", stop, True, False)),
+        daemon=True,
+    )
+    thread.start()
+    states: list[dict[str, Any]] = []
+    try:
+
+        def poll(predicate: Any) -> bool:
+            state = recorder.query_state()
+            if state is not None:
+                states.append(state)
+            return state is not None and bool(predicate(state))
+
+        assert wait_for(lambda: poll(lambda s: s["source_status"] == "reconnecting"), 60.0, 0.1)
+        assert wait_for(lambda: poll(lambda s: s["camera_reopens"] >= 1), 30.0, 0.1)
+        reopened_at = states[-1]["frames"]
+        assert wait_for(lambda: poll(lambda s: s["frames"] >= reopened_at + 10), 30.0, 0.1)
+    finally:
+        stop.set("test")
+        thread.join(timeout=30)
+    assert result == [0]
+    lost = next(s for s in states if s["source_status"] == "reconnecting")
+    assert lost["status"] == "degraded" and "lost" in lost["problems"][0]
+    assert 0 < lost["frames"] <= 60  # newest-frame-only: some of the 60 may be dropped
+    back = states[-1]
+    print(
+        f"lost: {lost['status']} {lost['problems']} after {lost['frames']} frames; back: "
+        f"{back['status']}, camera_reopens {back['camera_reopens']}, frames {back['frames']}"
+    )
+    assert back["status"] == "running" and back["problems"] == []
+    assert recorder.of("state")[-1]["status"] == "stopped"
+
+
+@pytest.mark.parametrize(
+    ("speed_payload", "expected"), [(b'{"kmh": 10}', 0), (b"50", 2), (None, 2)]
+)
+def test_sink_gates_alerts_on_the_speed_received(
+    speed_payload: bytes | None, expected: int
+) -> None:
+    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
+    link = FakeLink(speed=SpeedInput(stale_s=5.0))
+    assert link.speed is not None
+    if speed_payload is not None:
+        link.speed.on_payload(speed_payload)
+    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), link, "test")
+    for frame in range(180):
+        t_s = frame / 30
+        sink.on_sample(sample(t_s, 45.0 if 1.0 <= t_s < 5.0 else 0.0))
+    assert len(link.alerts) == expected
+    state = sink.state_message()
+    assert state.monitor.speed_source == ("waiting" if speed_payload is None else "fresh")
+    assert state.monitor.moving is (expected > 0)

@@ -24,7 +24,7 @@ import csv
 import importlib.resources
 import logging
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -32,7 +32,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.config import Config
 from roadgaze.errors import ConfigError, RoadgazeError, SourceError
+from roadgaze.landmarks import FACE_OVAL
 
 log = logging.getLogger(__name__)
 
@@ -103,7 +105,7 @@ class Timeline:
         return yaw, pitch
 
     def truth(self, fps: float) -> FloatArray:
-        """(N, 3) rows `t_s, yaw_deg, pitch_deg` for frames at `i / fps`, N = round(duration*fps)."""
+        """(N, 3) rows `t_s, yaw_deg, pitch_deg` at `i / fps`; N = round(duration * fps)."""
         n_frames = max(1, round(self.duration_s * fps))
         t = np.arange(n_frames, dtype=np.float64) / fps
         yaw, pitch = self.pose_at(t)
@@ -200,36 +202,19 @@ def mesh_triangles() -> npt.NDArray[np.int32]:
     return np.asarray(triangles, dtype=np.int32)
 
 
-def face_oval_indices() -> list[int]:
-    """Landmark indices of the face oval, in MediaPipe's order."""
-    from mediapipe.tasks.python.vision import FaceLandmarksConnections
+def photo_landmarks_px(photo_bgr: ImageBGR, config: Config | None = None) -> FloatArray:
+    """The driver face's (478, 3) landmarks in the photo, in pixels, from the landmark stage.
 
-    return [c.start for c in FaceLandmarksConnections.FACE_LANDMARKS_FACE_OVAL]
+    Raises SourceError when the photo shows no face, ModelError when the model is unavailable.
+    """
+    from roadgaze.landmarks import MediaPipeLandmarker
 
-
-def _photo_landmarks_px(photo_bgr: ImageBGR) -> FloatArray:
-    """The largest face's (478, 3) landmarks in pixels (z times the image width) via MediaPipe."""
-    import cv2
-    import mediapipe as mp
-    from mediapipe.tasks.python import BaseOptions, vision
-
-    model = Path.home() / ".cache" / "roadgaze" / "face_landmarker.task"
-    options = vision.FaceLandmarkerOptions(
-        base_options=BaseOptions(model_asset_path=str(model)),
-        running_mode=vision.RunningMode.IMAGE,
-        num_faces=4,
-    )
-    height, width = photo_bgr.shape[:2]
-    with vision.FaceLandmarker.create_from_options(options) as landmarker:
-        rgb = cv2.cvtColor(photo_bgr, cv2.COLOR_BGR2RGB)
-        result = landmarker.detect(mp.Image(image_format=mp.ImageFormat.SRGB, data=rgb))
-    faces = [
-        np.array([[p.x * width, p.y * height, p.z * width] for p in face], dtype=np.float64)
-        for face in result.face_landmarks
-    ]
-    if not faces:
+    config = config if config is not None else Config()
+    with MediaPipeLandmarker.from_config(config, video=False) as landmarker:
+        face = landmarker.detect(photo_bgr).driver
+    if face is None:
         raise SourceError("no face found in the photo; pass a photo with one clear frontal face")
-    return max(faces, key=lambda f: float(np.ptp(f[:, 0]) * np.ptp(f[:, 1])))
+    return np.asarray(face.landmarks_px, dtype=np.float64)
 
 
 @dataclass(frozen=True, slots=True)
@@ -247,7 +232,8 @@ class FaceRenderer:
     """Renders one photo's face turned to any yaw/pitch, at a fixed output size.
 
     Build once per photo and size (this runs MediaPipe once and in-paints the background), then
-    call `render(yaw_deg, pitch_deg)` per frame. `size` is (width, height) in pixels.
+    call `render(yaw_deg, pitch_deg)` per frame. `size` is (width, height) in pixels;
+    `landmarks_px` skips the landmarker (the photo's (478, 3) mesh), `config` chooses its model.
     """
 
     def __init__(
@@ -255,6 +241,7 @@ class FaceRenderer:
         photo_bgr: ImageBGR,
         size: tuple[int, int] = DEFAULT_SIZE,
         landmarks_px: FloatArray | None = None,
+        config: Config | None = None,
     ) -> None:
         import cv2
 
@@ -262,8 +249,10 @@ class FaceRenderer:
         if width < 64 or height < 64:
             raise ConfigError(f"frame size must be at least 64x64 px, found {width}x{height}")
         self.size = (int(width), int(height))
-        photo_points = _photo_landmarks_px(photo_bgr) if landmarks_px is None else landmarks_px
-        oval = photo_points[face_oval_indices()]
+        photo_points = (
+            photo_landmarks_px(photo_bgr, config) if landmarks_px is None else landmarks_px
+        )
+        oval = photo_points[list(FACE_OVAL)]
         photo_face_width = float(np.ptp(oval[:, 0]))
         scale = FACE_WIDTH_FRACTION * min(width, height) / photo_face_width
         centre_x = 0.5 * (oval[:, 0].min() + oval[:, 0].max())
@@ -288,7 +277,7 @@ class FaceRenderer:
         half_width = face_width_px / 2
         pivot = np.array(
             [
-                0.5 * (points[face_oval_indices(), 0].min() + points[face_oval_indices(), 0].max()),
+                0.5 * (points[list(FACE_OVAL), 0].min() + points[list(FACE_OVAL), 0].max()),
                 points[CHIN, 1],
                 points[NOSE_TIP, 2] + PIVOT_DEPTH_HALF_WIDTHS * half_width,
             ]
@@ -318,7 +307,8 @@ class FaceRenderer:
         mask = cv2.dilate(mask, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * grow + 1,) * 2))
         known = (mask == 0).astype(np.float32)
         filled = _push_pull_fill(self.texture.astype(np.float32), known)
-        return np.clip(filled + 0.5, 0, 255).astype(np.uint8)
+        background: ImageBGR = np.clip(filled + 0.5, 0, 255).astype(np.uint8)
+        return background
 
     def turned_points(self, yaw_deg: float, pitch_deg: float = 0.0) -> FloatArray:
         """The mesh turned by yaw (about the vertical axis) then pitch, about the neck pivot."""
@@ -455,6 +445,7 @@ def render_clip(
     fps: float = DEFAULT_FPS,
     size: tuple[int, int] = DEFAULT_SIZE,
     renderer: FaceRenderer | None = None,
+    config: Config | None = None,
 ) -> FloatArray:
     """Render the timeline to a video and its `<stem>.truth.csv`; return the (N, 3) truth.
 
@@ -475,11 +466,11 @@ def render_clip(
             f"cannot write '{out.suffix}' video {out}; use one of {', '.join(FOURCC_BY_SUFFIX)}"
         )
     if renderer is None:
-        renderer = FaceRenderer(load_photo(photo), size)
+        renderer = FaceRenderer(load_photo(photo), size, config=config)
     elif renderer.size != tuple(size):
         size = renderer.size
     out.parent.mkdir(parents=True, exist_ok=True)
-    writer = cv2.VideoWriter(str(out), cv2.VideoWriter_fourcc(*fourcc), fps, renderer.size)
+    writer = cv2.VideoWriter(str(out), cv2.VideoWriter.fourcc(*fourcc), fps, renderer.size)
     if not writer.isOpened():
         raise RoadgazeError(f"cannot open {out} for writing a {fourcc} video; check the folder")
     rows = []
@@ -494,6 +485,155 @@ def render_clip(
     return truth
 
 
-def yaw_ranges_deg() -> Sequence[tuple[float, float]]:
-    """The |yaw| ranges the measurement reports on."""
-    return ((0.0, 15.0), (15.0, 30.0), (30.0, 45.0), (45.0, 60.0))
+YAW_RANGES_DEG: tuple[tuple[float, float], ...] = (
+    (0.0, 15.0),
+    (15.0, 30.0),
+    (30.0, 45.0),
+    (45.0, 60.0),
+)
+"""The |true yaw| ranges the measurement reports on; each includes its low end, the last both."""
+
+
+@dataclass(frozen=True, slots=True)
+class RangeError:
+    """Errors (estimate minus truth, degrees) of the frames whose |true yaw| lies in a range."""
+
+    low_deg: float
+    high_deg: float
+    frames: int
+    estimated: int
+    """Frames with a face and a finite estimate; the errors are over these."""
+    mae_deg: float
+    bias_deg: float
+    """Mean signed error of the frames with positive truth minus that of negative truth, halved:
+    the part of the error that grows with |yaw| (an offset common to both signs cancels)."""
+    offset_deg: float
+    """Mean signed error over the range: the part common to both signs."""
+    max_error_deg: float
+
+
+@dataclass(frozen=True, slots=True)
+class YawRecovery:
+    """Yaw estimated on a rendered sweep against its truth."""
+
+    truth_deg: FloatArray
+    estimate_deg: FloatArray
+    """NaN where no face was found or the yaw model could not explain the geometry."""
+    ranges: tuple[RangeError, ...]
+    overall: RangeError
+    model: str
+    size: tuple[int, int]
+    video: bool
+
+
+def range_error(
+    truth_deg: FloatArray, estimate_deg: FloatArray, low_deg: float, high_deg: float, last: bool
+) -> RangeError:
+    """Errors of the frames with low <= |truth| < high (<= high when `last`)."""
+    magnitude = np.abs(truth_deg)
+    inside = (magnitude >= low_deg) & ((magnitude <= high_deg) if last else (magnitude < high_deg))
+    valid = inside & np.isfinite(estimate_deg)
+    error = estimate_deg[valid] - truth_deg[valid]
+    sign = np.sign(truth_deg[valid])
+    nan = float("nan")
+
+    def mean(values: FloatArray) -> float:
+        return float(values.mean()) if values.size else nan
+
+    positive, negative = mean(error[sign > 0]), mean(error[sign < 0])
+    return RangeError(
+        low_deg=low_deg,
+        high_deg=high_deg,
+        frames=int(inside.sum()),
+        estimated=int(valid.sum()),
+        mae_deg=mean(np.abs(error)),
+        bias_deg=0.5 * (positive - negative),
+        offset_deg=mean(error),
+        max_error_deg=float(np.abs(error).max()) if error.size else nan,
+    )
+
+
+def measure_yaw_recovery(
+    config: Config | None = None,
+    photo: Path | None = None,
+    size: tuple[int, int] = DEFAULT_SIZE,
+    step_deg: float = 1.0,
+    max_yaw_deg: float = 60.0,
+    video: bool = True,
+    renderer: FaceRenderer | None = None,
+) -> YawRecovery:
+    """Render a yaw sweep -max..max in `step_deg` steps and estimate each frame's yaw.
+
+    The estimate is the landmark stage (MediaPipe, the configured landmark choice) followed by the
+    configured yaw model (Center-CE by default), exactly as `Pipeline.raw_yaw_deg` computes it.
+    `video`: run the landmarker in VIDEO mode over the sweep as a 15 fps clip (as the service
+    does); False: each still in IMAGE mode.
+    """
+    from roadgaze.landmarks import MediaPipeLandmarker
+    from roadgaze.model_store import resolve_model
+    from roadgaze.pipeline import Pipeline
+
+    config = config if config is not None else Config()
+    renderer = (
+        renderer if renderer is not None else FaceRenderer(load_photo(photo), size, config=config)
+    )
+    count = round(2 * max_yaw_deg / step_deg) + 1
+    truth = np.linspace(-max_yaw_deg, max_yaw_deg, count)
+    estimate = np.full(count, np.nan)
+    model_path = resolve_model(config.model)
+    with MediaPipeLandmarker(config.landmarks, model_path, video=video) as detector:
+        pipeline = Pipeline.from_config(config, detector)
+        for index, yaw_deg in enumerate(truth):
+            image = renderer.render(float(yaw_deg))
+            detection = detector.detect(image, index / DEFAULT_FPS if video else None)
+            value = pipeline.raw_yaw_deg(detection.driver)
+            if value is not None:
+                estimate[index] = value
+    last = len(YAW_RANGES_DEG) - 1
+    ranges = tuple(
+        range_error(truth, estimate, low, high, i == last)
+        for i, (low, high) in enumerate(YAW_RANGES_DEG)
+        if low < max_yaw_deg
+    )
+    overall = range_error(truth, estimate, 0.0, max_yaw_deg, True)
+    return YawRecovery(
+        truth, estimate, ranges, overall, config.geometry.model, renderer.size, video
+    )
+
+
+def format_measurement(result: YawRecovery) -> str:
+    """A table of frames, detections, MAE, sign-dependent bias, offset and max error per range."""
+    mode = "VIDEO mode sweep" if result.video else "IMAGE mode stills"
+    lines = [
+        f"yaw recovery on synthetic frames ({result.size[0]}x{result.size[1]}, {mode}, "
+        f"model {result.model}); errors are estimate - truth in degrees",
+        f"{'|yaw| range':>12} {'frames':>6} {'found':>6} {'MAE':>6} {'bias':>6} {'offset':>7} "
+        f"{'max':>6}",
+    ]
+    for item in (*result.ranges, result.overall):
+        label = f"{item.low_deg:g}-{item.high_deg:g}"
+        lines.append(
+            f"{label:>12} {item.frames:>6} {item.estimated:>6} {item.mae_deg:>6.2f} "
+            f"{item.bias_deg:>+6.2f} {item.offset_deg:>+7.2f} {item.max_error_deg:>6.2f}"
+        )
+    lines.append(
+        "bias: half the difference of the mean errors at positive and negative yaw (>0 means the "
+        "magnitude is overestimated); offset: mean error common to both signs."
+    )
+    return "\n".join(lines)
+
+
+def write_measurement_csv(path: Path, result: YawRecovery) -> None:
+    """Rows `truth_yaw_deg,estimate_yaw_deg,error_deg` (empty where no estimate)."""
+    with Path(path).open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(("truth_yaw_deg", "estimate_yaw_deg", "error_deg"))
+        for truth, estimate in zip(result.truth_deg, result.estimate_deg, strict=True):
+            found = math.isfinite(estimate)
+            writer.writerow(
+                (
+                    f"{truth:.3f}",
+                    f"{estimate:.3f}" if found else "",
+                    f"{estimate - truth:.3f}" if found else "",
+                )
+            )

@@ -1,0 +1,344 @@
+"""`roadgaze demo`: a synthetic drive through the whole service, with a Zenoh subscriber watching.
+
+One run, no camera and no video needed: the astronaut photo (or `photo`) is turned through a short
+drive (road, one long glance away, a few short ones, road again) by `roadgaze.synth`; the service
+(`roadgaze.pipeline` + `roadgaze.daemon.publishing_sink`: landmarks, Center-CE, Kalman smoother,
+monitor, Zenoh publisher on 127.0.0.1) runs over the clip as fast as it can; a second Zenoh session,
+connected to the first over loopback, subscribes to the alert key and reports each alert as it
+arrives. The output folder then holds the clip and its truth, the per-frame records, the received
+alerts, a plot and the annotated video.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import socket
+import threading
+import time
+from collections.abc import Callable
+from contextlib import ExitStack
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from roadgaze.config import Config
+from roadgaze.errors import RoadgazeError
+from roadgaze.synth import FloatArray, Timeline, parse_timeline, write_truth_csv
+from roadgaze.types import YawSample
+
+log = logging.getLogger(__name__)
+
+DRIVE_TIMELINE = "0:3,40:5,0:2,-35:1.5,0:1.5,35:1.5,0:1.5,-40:1.5,0:1.5,30:1.5,0:3"
+"""Road 3 s; a 5 s glance to the left (a long-distraction alert); four 1.5 s glances that push the
+off-road time in the last 30 s over 10 s (a VATS alert); back to the road (cleared)."""
+DEMO_FPS = 15.0
+DEMO_SIZE = (640, 480)
+SUBSCRIBER_WAIT_S = 10.0
+"""How long to wait for the subscriber to see the publisher, and for the last alerts to arrive."""
+
+VIDEO_NAME = "drive.mp4"
+TRUTH_NAME = "truth.csv"
+FRAMES_NAME = "frames.jsonl"
+ALERTS_NAME = "alerts.jsonl"
+PLOT_NAME = "yaw.png"
+ANNOTATED_NAME = "annotated.mp4"
+
+
+@dataclass(frozen=True, slots=True)
+class DemoResult:
+    """What a demo run produced, and how long its parts took."""
+
+    out_dir: Path
+    frames: int
+    frames_with_face: int
+    alerts_raised: int
+    alerts_received: tuple[dict[str, Any], ...]
+    """The alert messages as the subscriber decoded them, in arrival order."""
+    render_s: float
+    service_s: float
+    total_s: float
+    yaw_mae_deg: float
+    """Mean |smoothed yaw - truth| over the frames with a smoothed yaw."""
+    files: tuple[Path, ...]
+
+
+def free_local_port() -> int:
+    """A TCP port on 127.0.0.1 that is free right now (for the demo's own Zenoh listener)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
+
+
+def demo_config(base: Config, port: int) -> Config:
+    """`base` with the demo's Zenoh settings: a peer listening on 127.0.0.1:`port`, no scouting."""
+    zenoh = base.zenoh.model_copy(
+        update={
+            "mode": "peer",
+            "listen": [f"tcp/127.0.0.1:{port}"],
+            "connect": [],
+            "multicast_scouting": False,
+            "config_file": None,
+        }
+    )
+    return base.model_copy(update={"zenoh": zenoh})
+
+
+def subscriber_config(config: Config, port: int) -> Config:
+    """A peer that listens nowhere and connects to the demo's publisher on 127.0.0.1:`port`."""
+    zenoh = config.zenoh.model_copy(
+        update={"mode": "peer", "listen": [], "connect": [f"tcp/127.0.0.1:{port}"]}
+    )
+    return config.model_copy(update={"zenoh": zenoh})
+
+
+class AlertSubscriber:
+    """A Zenoh subscriber to the alert key in its own session; appends each alert to a file.
+
+    `on_alert` is called from the receiving thread with each decoded message, in arrival order.
+    """
+
+    def __init__(
+        self,
+        config: Config,
+        alerts_path: Path,
+        on_alert: Callable[[dict[str, Any]], None],
+    ) -> None:
+        from roadgaze.transport import Keys, open_session
+
+        self.keys = Keys.from_config(config.zenoh)
+        self._on_alert = on_alert
+        self._lock = threading.Lock()
+        self.received: list[dict[str, Any]] = []
+        self._file = alerts_path.open("w", encoding="utf-8")
+        self._session: Any = None
+        self._subscriber: Any = None
+        try:
+            self._session = open_session(config.zenoh)
+            self._subscriber = self._session.declare_subscriber(self.keys.alert, self._on_sample)
+        except BaseException:
+            self.close()
+            raise
+
+    def _on_sample(self, sample: Any) -> None:
+        raw = sample.payload.to_bytes()
+        try:
+            message = json.loads(raw)
+        except ValueError:
+            message = {"undecodable": raw.decode("utf-8", "replace")}
+        with self._lock:
+            if self._file.closed:
+                return
+            self.received.append(message)
+            self._file.write(json.dumps(message) + "\n")
+            self._file.flush()
+        self._on_alert(message)
+
+    def wait_for_publisher(self, timeout_s: float) -> bool:
+        """True once the publisher's liveliness token is visible (routes are then in place)."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            replies = self._session.liveliness().get(self.keys.alive, timeout=0.5)
+            if any(reply.ok is not None for reply in replies):
+                return True
+            time.sleep(0.05)
+        return False
+
+    def wait_for_count(self, count: int, timeout_s: float) -> bool:
+        """True once `count` alerts have arrived; False after `timeout_s`."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            with self._lock:
+                if len(self.received) >= count:
+                    return True
+            time.sleep(0.02)
+        with self._lock:
+            return len(self.received) >= count
+
+    def close(self) -> None:
+        if self._subscriber is not None:
+            self._subscriber.undeclare()
+            self._subscriber = None
+        if self._session is not None:
+            self._session.close()
+            self._session = None
+        with self._lock:
+            self._file.close()
+
+
+class DriveRecorder:
+    """Sample sink collecting truth-aligned yaw and the monitor's alerts for the demo's plot."""
+
+    def __init__(self) -> None:
+        self.t_s: list[float] = []
+        self.raw_deg: list[float] = []
+        self.smoothed_deg: list[float] = []
+
+    def on_sample(self, sample: YawSample) -> None:
+        self.t_s.append(sample.t_s)
+        self.raw_deg.append(math.nan if sample.yaw_raw_deg is None else sample.yaw_raw_deg)
+        self.smoothed_deg.append(math.nan if sample.yaw_deg is None else sample.yaw_deg)
+
+    def close(self) -> None:
+        return None
+
+
+def save_drive_plot(
+    path: Path,
+    truth: FloatArray,
+    recorder: DriveRecorder,
+    alerts: list[Any],
+    road_half_width_deg: float,
+) -> None:
+    """PNG of truth, raw and smoothed yaw over time, the road band and each alert marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(figsize=(10, 4.5), dpi=110)
+    axes.axhspan(-road_half_width_deg, road_half_width_deg, color="tab:green", alpha=0.08)
+    axes.plot(truth[:, 0], truth[:, 1], "-", color="black", linewidth=1.2, label="truth")
+    axes.plot(recorder.t_s, recorder.raw_deg, ".", color="tab:gray", markersize=3, label="raw")
+    axes.plot(recorder.t_s, recorder.smoothed_deg, "-", color="tab:blue", label="smoothed")
+    colours = {"warning": "tab:orange", "critical": "tab:red", "info": "tab:green"}
+    top = axes.get_ylim()[1]
+    for alert in alerts:
+        colour = colours.get(alert.level.value, "tab:purple")
+        axes.axvline(alert.t_s, color=colour, linestyle="--", linewidth=1)
+        axes.text(
+            alert.t_s, top, f" {alert.kind.value}", rotation=90, va="top", fontsize=7, color=colour
+        )
+    axes.set_xlabel("time (s)")
+    axes.set_ylabel("yaw (deg, + = driver's left)")
+    axes.set_title("roadgaze demo: synthetic drive (green band: road ahead)")
+    axes.legend(loc="lower left", fontsize=8)
+    axes.grid(alpha=0.3)
+    figure.tight_layout()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        figure.savefig(path)
+    except OSError as exc:
+        raise RoadgazeError(f"cannot write plot {path}: {exc.strerror or exc}") from None
+    finally:
+        plt.close(figure)
+
+
+def format_alert(message: dict[str, Any]) -> str:
+    """One line for an alert message as received."""
+    if "kind" not in message:
+        return f"subscriber: undecodable alert {message}"
+    yaw = message.get("yaw_deg")
+    yaw_text = "no face" if yaw is None else f"yaw {yaw:+.1f} deg"
+    return (
+        f"subscriber received alert #{message.get('seq')}: {message.get('kind')} "
+        f"{message.get('level')} at t={message.get('t_s', 0.0):.2f} s "
+        f"(off road {message.get('off_road_s', 0.0):.2f} s, "
+        f"{message.get('window_off_road_s', 0.0):.2f} s in the window; {yaw_text})"
+    )
+
+
+def run_demo(
+    out_dir: Path,
+    config: Config | None = None,
+    photo: Path | None = None,
+    timeline: Timeline | None = None,
+    fps: float = DEMO_FPS,
+    size: tuple[int, int] = DEMO_SIZE,
+    on_alert: Callable[[dict[str, Any]], None] | None = None,
+    on_progress: Callable[[str], None] | None = None,
+) -> DemoResult:
+    """Render the drive, run the service over it with a subscriber, write everything to `out_dir`.
+
+    Raises RoadgazeError (ModelError, SourceError, TransportError ...) with a clear message; what
+    was written before an error stays in `out_dir`.
+    """
+    from roadgaze.capture import open_source
+    from roadgaze.daemon import publishing_sink
+    from roadgaze.outputs import AnnotatedVideoWriter, JsonlWriter
+    from roadgaze.pipeline import Pipeline, Sink, create_detector
+    from roadgaze.synth import FaceRenderer, load_photo, render_clip
+
+    started = time.perf_counter()
+    progress = on_progress if on_progress is not None else (lambda text: None)
+    on_alert = on_alert if on_alert is not None else (lambda message: None)
+    config = config if config is not None else Config()
+    timeline = timeline if timeline is not None else parse_timeline(DRIVE_TIMELINE)
+    out_dir = Path(out_dir)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise RoadgazeError(f"cannot create output folder {out_dir}: {exc.strerror}") from None
+
+    progress(f"rendering a {timeline.duration_s:g} s drive at {fps:g} fps, {size[0]}x{size[1]}")
+    renderer = FaceRenderer(load_photo(photo), size, config=config)
+    video_path = out_dir / VIDEO_NAME
+    truth = render_clip(timeline, video_path, fps=fps, renderer=renderer)
+    truth_csv = out_dir / TRUTH_NAME
+    write_truth_csv(truth_csv, truth)
+    video_path.with_name(video_path.stem + ".truth.csv").unlink(missing_ok=True)
+    rendered = time.perf_counter()
+
+    port = free_local_port()
+    config = demo_config(config, port)
+    recorder = DriveRecorder()
+    progress(f"running the service over {VIDEO_NAME}, Zenoh on tcp/127.0.0.1:{port}")
+    with ExitStack() as stack:
+        source = stack.enter_context(open_source(str(video_path), config))
+        detector = create_detector(config)
+        stack.callback(detector.close)
+        monitor = stack.enter_context(publishing_sink(config, str(video_path), publish=True))
+        subscriber = AlertSubscriber(
+            subscriber_config(config, port), out_dir / ALERTS_NAME, on_alert
+        )
+        stack.callback(subscriber.close)
+        if not subscriber.wait_for_publisher(SUBSCRIBER_WAIT_S):
+            log.warning("the subscriber did not see the publisher within %.0f s", SUBSCRIBER_WAIT_S)
+        frames_writer = stack.enter_context(
+            JsonlWriter(out_dir / FRAMES_NAME, extras=[monitor.extras])
+        )
+        annotated = stack.enter_context(
+            AnnotatedVideoWriter(
+                out_dir / ANNOTATED_NAME,
+                fps,
+                state_text=lambda sample: f"gaze {monitor.last_extras.get('gaze', '?')}",
+            )
+        )
+        sinks: list[Sink] = [monitor, recorder, frames_writer, annotated]
+        summary = Pipeline.from_config(config, detector).run(source, sinks)
+        raised = len(monitor.alerts)
+        if not subscriber.wait_for_count(raised, SUBSCRIBER_WAIT_S):
+            log.warning("the subscriber received %d of %d alerts", len(subscriber.received), raised)
+        received = tuple(subscriber.received)
+        alerts = list(monitor.alerts)
+    served = time.perf_counter()
+
+    plot_path = out_dir / PLOT_NAME
+    save_drive_plot(plot_path, truth, recorder, alerts, config.monitor.road_half_width_deg)
+    smoothed = np.asarray(recorder.smoothed_deg)
+    count = min(len(smoothed), len(truth))
+    errors = np.abs(smoothed[:count] - truth[:count, 1])
+    finite = errors[np.isfinite(errors)]
+    return DemoResult(
+        out_dir=out_dir,
+        frames=summary.frames,
+        frames_with_face=summary.frames_with_face,
+        alerts_raised=raised,
+        alerts_received=received,
+        render_s=rendered - started,
+        service_s=served - rendered,
+        total_s=time.perf_counter() - started,
+        yaw_mae_deg=float(finite.mean()) if finite.size else math.nan,
+        files=(
+            out_dir / VIDEO_NAME,
+            truth_csv,
+            out_dir / FRAMES_NAME,
+            out_dir / ALERTS_NAME,
+            plot_path,
+            out_dir / ANNOTATED_NAME,
+        ),
+    )

@@ -1,9 +1,12 @@
-"""Shared test fixtures: where the repository and the evaluation data are, subprocess env."""
+"""Shared test fixtures: where the repository and the evaluation data are, subprocess env, and
+synthetic clips of a face turning to known yaws (no data needed)."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -26,3 +29,40 @@ def subprocess_env() -> dict[str, str]:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
     return env
+
+
+# --- Synthetic ground-truth video (roadgaze.synth): fixtures that need no ../shared data -------
+
+SYNTHETIC_SIZE = (320, 320)
+SYNTHETIC_FPS = 15.0
+
+
+@pytest.fixture(scope="session")
+def synthetic_renderer() -> Any:
+    """One `FaceRenderer` of the astronaut photo at 320x320, shared by the whole session."""
+    from roadgaze.synth import FaceRenderer, load_photo
+
+    return FaceRenderer(load_photo(), SYNTHETIC_SIZE)
+
+
+@pytest.fixture(scope="session")
+def synthetic_clip(
+    tmp_path_factory: pytest.TempPathFactory, synthetic_renderer: Any
+) -> Callable[[str], tuple[Path, Any]]:
+    """Factory: `synthetic_clip("0:1,40:2")` -> (video path, (N, 3) truth `t_s,yaw,pitch`).
+
+    320x320 at 15 fps, lossless FFV1 .mkv; each timeline is rendered once per session.
+    """
+    from roadgaze.synth import render_clip
+
+    folder = tmp_path_factory.mktemp("synthetic")
+    made: dict[str, tuple[Path, Any]] = {}
+
+    def make(timeline: str) -> tuple[Path, Any]:
+        if timeline not in made:
+            path = folder / f"clip{len(made)}.mkv"
+            truth = render_clip(timeline, path, fps=SYNTHETIC_FPS, renderer=synthetic_renderer)
+            made[timeline] = (path, truth)
+        return made[timeline]
+
+    return make

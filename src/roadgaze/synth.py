@@ -51,6 +51,7 @@ PIVOT_DEPTH_HALF_WIDTHS = 1.5
 """Neck pivot behind the nose tip in half face widths: the paper's alpha + beta = 0.25 + 1.25."""
 FACE_WIDTH_FRACTION = 0.32
 """Face width in the output frame as a fraction of the frame's smaller side."""
+TESSELLATION_TRIANGLES = 852
 NOSE_TIP = 1
 CHIN = 152
 TRUTH_HEADER = ("t_s", "yaw_deg", "pitch_deg")
@@ -191,15 +192,66 @@ def load_photo(photo: Path | None = None) -> ImageBGR:
     return np.ascontiguousarray(image, dtype=np.uint8)
 
 
+def _boundary_loops(triangles: npt.NDArray[np.int32]) -> list[list[int]]:
+    """The closed loops of edges used by exactly one triangle (the mesh's border and holes)."""
+    uses: dict[tuple[int, int], int] = {}
+    for a, b, c in triangles.tolist():
+        for edge in ((a, b), (b, c), (c, a)):
+            key = (min(edge), max(edge))
+            uses[key] = uses.get(key, 0) + 1
+    neighbours: dict[int, list[int]] = {}
+    for (a, b), count in uses.items():
+        if count == 1:
+            neighbours.setdefault(a, []).append(b)
+            neighbours.setdefault(b, []).append(a)
+    loops: list[list[int]] = []
+    seen: set[int] = set()
+    for start in neighbours:
+        if start in seen:
+            continue
+        loop, previous, current = [start], -1, start
+        seen.add(start)
+        for _ in range(len(neighbours)):
+            following = next(n for n in neighbours[current] if n != previous)
+            if following == start:
+                break
+            loop.append(following)
+            seen.add(following)
+            previous, current = current, following
+        loops.append(loop)
+    return loops
+
+
+def _strip(loop: list[int]) -> list[tuple[int, int, int]]:
+    """Triangulate a convex-ish loop as a zig-zag strip between its two ends."""
+    triangles = []
+    left, right = 0, len(loop) - 1
+    while right - left >= 2:
+        triangles.append((loop[left], loop[left + 1], loop[right]))
+        left += 1
+        if right - left >= 2:
+            triangles.append((loop[left], loop[right - 1], loop[right]))
+            right -= 1
+    return triangles
+
+
 def mesh_triangles() -> npt.NDArray[np.int32]:
-    """(852, 3) vertex indices of MediaPipe's face mesh, from its tessellation edge triples."""
+    """(898, 3) vertex indices: MediaPipe's 852 tessellation triangles and 46 that close its holes.
+
+    The tessellation (its edges come in triangle triples) leaves the eye openings and the mouth
+    open; those three loops are closed with strips so the eyes and lips are re-rendered too. The
+    winding is not consistent for the added triangles (`FaceRenderer` fixes it from the photo).
+    """
     from mediapipe.tasks.python.vision import FaceLandmarksConnections
 
     edges = FaceLandmarksConnections.FACE_LANDMARKS_TESSELATION
-    triangles = [
-        (edges[i].start, edges[i + 1].start, edges[i + 2].start) for i in range(0, len(edges), 3)
-    ]
-    return np.asarray(triangles, dtype=np.int32)
+    triangles = np.asarray(
+        [(edges[i].start, edges[i + 1].start, edges[i + 2].start) for i in range(0, len(edges), 3)],
+        dtype=np.int32,
+    )
+    loops = sorted(_boundary_loops(triangles), key=len)[:-1]  # the longest is the face's border
+    holes = [triangle for loop in loops for triangle in _strip(loop)]
+    return np.concatenate([triangles, np.asarray(holes, dtype=np.int32).reshape(-1, 3)])
 
 
 def photo_landmarks_px(photo_bgr: ImageBGR, config: Config | None = None) -> FloatArray:
@@ -285,6 +337,9 @@ class FaceRenderer:
         self.mesh = PhotoMesh(points, pivot, face_width_px)
         self.triangles = mesh_triangles()
         self._front_sign = self._majority_sign(points)
+        backwards = self._signed_areas(points) * self._front_sign < 0
+        backwards[:TESSELLATION_TRIANGLES] = False  # only the hole fillers have no set winding
+        self.triangles[backwards] = self.triangles[backwards][:, ::-1]
         self.background = self._inpaint_face(cv2)
         ys, xs = np.mgrid[0:height, 0:width]
         self._pixel_x = xs.astype(np.float64)

@@ -576,6 +576,11 @@ class YawRecovery:
     """NaN where no face was found or the yaw model could not explain the geometry."""
     ranges: tuple[RangeError, ...]
     overall: RangeError
+    mesh_estimate_deg: FloatArray
+    """The same yaw model on the turned mesh's own landmarks (a perfect landmarker): separates
+    the face model's and the mesh's share of the error from the landmarker's."""
+    mesh_ranges: tuple[RangeError, ...]
+    mesh_overall: RangeError
     model: str
     size: tuple[int, int]
     video: bool
@@ -624,7 +629,7 @@ def measure_yaw_recovery(
     `video`: run the landmarker in VIDEO mode over the sweep as a 15 fps clip (as the service
     does); False: each still in IMAGE mode.
     """
-    from roadgaze.landmarks import MediaPipeLandmarker
+    from roadgaze.landmarks import MediaPipeLandmarker, features_from_landmarks
     from roadgaze.model_store import resolve_model
     from roadgaze.pipeline import Pipeline
 
@@ -635,6 +640,7 @@ def measure_yaw_recovery(
     count = round(2 * max_yaw_deg / step_deg) + 1
     truth = np.linspace(-max_yaw_deg, max_yaw_deg, count)
     estimate = np.full(count, np.nan)
+    mesh_estimate = np.full(count, np.nan)
     model_path = resolve_model(config.model)
     with MediaPipeLandmarker(config.landmarks, model_path, video=video) as detector:
         pipeline = Pipeline.from_config(config, detector)
@@ -644,51 +650,74 @@ def measure_yaw_recovery(
             value = pipeline.raw_yaw_deg(detection.driver)
             if value is not None:
                 estimate[index] = value
+            exact = features_from_landmarks(renderer.turned_points(float(yaw_deg)), renderer.size)
+            value = pipeline.raw_yaw_deg(exact)
+            if value is not None:
+                mesh_estimate[index] = value
     last = len(YAW_RANGES_DEG) - 1
-    ranges = tuple(
-        range_error(truth, estimate, low, high, i == last)
-        for i, (low, high) in enumerate(YAW_RANGES_DEG)
-        if low < max_yaw_deg
-    )
-    overall = range_error(truth, estimate, 0.0, max_yaw_deg, True)
+
+    def by_range(values: FloatArray) -> tuple[RangeError, ...]:
+        return tuple(
+            range_error(truth, values, low, high, i == last)
+            for i, (low, high) in enumerate(YAW_RANGES_DEG)
+            if low < max_yaw_deg
+        )
+
     return YawRecovery(
-        truth, estimate, ranges, overall, config.geometry.model, renderer.size, video
+        truth_deg=truth,
+        estimate_deg=estimate,
+        ranges=by_range(estimate),
+        overall=range_error(truth, estimate, 0.0, max_yaw_deg, True),
+        mesh_estimate_deg=mesh_estimate,
+        mesh_ranges=by_range(mesh_estimate),
+        mesh_overall=range_error(truth, mesh_estimate, 0.0, max_yaw_deg, True),
+        model=config.geometry.model,
+        size=renderer.size,
+        video=video,
     )
 
 
 def format_measurement(result: YawRecovery) -> str:
-    """A table of frames, detections, MAE, sign-dependent bias, offset and max error per range."""
+    """Per range: frames, detections, MAE, bias, offset and max error, then the same model's MAE
+    and bias on the turned mesh's own landmarks."""
     mode = "VIDEO mode sweep" if result.video else "IMAGE mode stills"
     lines = [
         f"yaw recovery on synthetic frames ({result.size[0]}x{result.size[1]}, {mode}, "
         f"model {result.model}); errors are estimate - truth in degrees",
         f"{'|yaw| range':>12} {'frames':>6} {'found':>6} {'MAE':>6} {'bias':>6} {'offset':>7} "
-        f"{'max':>6}",
+        f"{'max':>6} | {'mesh MAE':>8} {'mesh bias':>9}",
     ]
-    for item in (*result.ranges, result.overall):
+    rows = zip(
+        (*result.ranges, result.overall), (*result.mesh_ranges, result.mesh_overall), strict=True
+    )
+    for item, mesh in rows:
         label = f"{item.low_deg:g}-{item.high_deg:g}"
         lines.append(
             f"{label:>12} {item.frames:>6} {item.estimated:>6} {item.mae_deg:>6.2f} "
-            f"{item.bias_deg:>+6.2f} {item.offset_deg:>+7.2f} {item.max_error_deg:>6.2f}"
+            f"{item.bias_deg:>+6.2f} {item.offset_deg:>+7.2f} {item.max_error_deg:>6.2f} | "
+            f"{mesh.mae_deg:>8.2f} {mesh.bias_deg:>+9.2f}"
         )
     lines.append(
-        "bias: half the difference of the mean errors at positive and negative yaw (>0 means the "
-        "magnitude is overestimated); offset: mean error common to both signs."
+        "bias: half the difference of the mean errors at positive and negative yaw (< 0: the "
+        "magnitude is underestimated); offset: mean error common to both signs; mesh: the same "
+        "model on the rendered mesh's exact landmarks (no landmarker error)."
     )
     return "\n".join(lines)
 
 
 def write_measurement_csv(path: Path, result: YawRecovery) -> None:
-    """Rows `truth_yaw_deg,estimate_yaw_deg,error_deg` (empty where no estimate)."""
+    """Rows `truth_yaw_deg,estimate_yaw_deg,error_deg,mesh_estimate_yaw_deg` (empty: none)."""
     with Path(path).open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
-        writer.writerow(("truth_yaw_deg", "estimate_yaw_deg", "error_deg"))
-        for truth, estimate in zip(result.truth_deg, result.estimate_deg, strict=True):
+        writer.writerow(("truth_yaw_deg", "estimate_yaw_deg", "error_deg", "mesh_estimate_yaw_deg"))
+        rows = zip(result.truth_deg, result.estimate_deg, result.mesh_estimate_deg, strict=True)
+        for truth, estimate, mesh in rows:
             found = math.isfinite(estimate)
             writer.writerow(
                 (
                     f"{truth:.3f}",
                     f"{estimate:.3f}" if found else "",
                     f"{estimate - truth:.3f}" if found else "",
+                    f"{mesh:.3f}" if math.isfinite(mesh) else "",
                 )
             )

@@ -71,6 +71,11 @@ def register(subparsers: Any) -> None:
     measure.add_argument(
         "--max-yaw", type=float, default=60.0, metavar="DEG", help="sweep -DEG..DEG (default 60)"
     )
+    measure.add_argument(
+        "--stills",
+        action="store_true",
+        help="run the landmarker on each still in IMAGE mode (default: VIDEO mode over the sweep)",
+    )
     measure.add_argument("--csv", type=Path, metavar="FILE", help="write per-yaw results here")
     parser.set_defaults(handler=run)
 
@@ -88,7 +93,12 @@ def run(args: argparse.Namespace) -> int:
         if not 0.0 < args.max_yaw <= 80.0:
             raise ConfigError(f"--max-yaw must be within 0..80 deg, found {args.max_yaw}")
         result = measure_yaw_recovery(
-            config, photo=args.photo, size=size, step_deg=args.step, max_yaw_deg=args.max_yaw
+            config,
+            photo=args.photo,
+            size=size,
+            step_deg=args.step,
+            max_yaw_deg=args.max_yaw,
+            video=not args.stills,
         )
         print(format_measurement(result))
         if args.csv is not None:

@@ -94,19 +94,26 @@ class StageStats:
 
 
 class StageTimings:
-    """Per-stage times of the most recent `capacity` frames (a fixed ring: memory stays flat)."""
+    """Per-stage times of the most recent `capacity` frames (a fixed ring: memory stays flat).
 
-    def __init__(self, capacity: int = 20_000) -> None:
+    The first `skip_first` frames (model start-up) are not recorded.
+    """
+
+    def __init__(self, capacity: int = 20_000, skip_first: int = 0) -> None:
         self._times_ms: npt.NDArray[np.float64] = np.zeros((capacity, len(STAGES)))
         self._count = 0
+        self._to_skip = skip_first
 
     def add(self, times: StageTimes) -> None:
+        if self._to_skip > 0:
+            self._to_skip -= 1
+            return
         self._times_ms[self._count % len(self._times_ms)] = times.as_tuple()
         self._count += 1
 
     @property
     def count(self) -> int:
-        """Frames recorded in total (may exceed what the ring holds)."""
+        """Frames recorded in total, skipped ones excluded (may exceed what the ring holds)."""
         return self._count
 
     def stats(self) -> dict[str, StageStats]:

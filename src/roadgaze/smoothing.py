@@ -92,6 +92,8 @@ class YawSmoother:
             if yaw_deg is None:
                 self._t_s = t_s
                 return None
+            if self._started:
+                self._reinitialisations += 1
             self._start(t_s, yaw_deg)
             return self._estimate()
         assert self._t_s is not None and self._last_measurement_t_s is not None

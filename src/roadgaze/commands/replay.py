@@ -190,13 +190,14 @@ def run(args: argparse.Namespace) -> int:
     from roadgaze.capture import open_source
     from roadgaze.daemon import publishing_sink
     from roadgaze.errors import ConfigError
-    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.pipeline import Pipeline, create_detector, sigterm_as_interrupt
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
     config = monitor_config(args, config_from_args(args))
     stats = ReplayStats()
     with ExitStack() as stack:
+        stack.enter_context(sigterm_as_interrupt())
         source = stack.enter_context(open_source(args.source, config))
         detector = create_detector(config)
         stack.callback(detector.close)

@@ -38,17 +38,9 @@ from roadgaze.types import YawSample
 from zenoh_helpers import LineReader, endpoint, free_port, router, stop_process, wait_for
 
 REPO = Path(__file__).resolve().parents[1]
-DATA = REPO.parent / "shared" / "data"
-STILLS = DATA / "pointing04-dev" / "images" / "Person01"
-FRONTAL = STILLS / "person01146+0+0.jpg"
-SIDE_45 = STILLS / "person01143+0-45.jpg"
 CLIP_FPS = 15
 SCHEMAS = json_schemas()
 ENV = {**os.environ, "PYTHONPATH": str(REPO / "src"), "GLOG_minloglevel": "2"}
-
-needs_data = pytest.mark.skipif(
-    not FRONTAL.is_file(), reason=f"Pointing'04 stills not found under {DATA} (evaluation data)"
-)
 
 
 @pytest.fixture(autouse=True)
@@ -120,32 +112,29 @@ def test_state_is_degraded_when_the_camera_or_zenoh_is_lost() -> None:
     assert sink.state_message().problems == ["zenoh not connected"]
 
 
-def write_clip(path: Path, segments: list[tuple[Path, float]]) -> Path:
-    import cv2
+def synthetic_clip_file(path: Path, renderer: Any, segments: list[tuple[float, float]]) -> Path:
+    """An MJPG clip of the synthetic face holding each (yaw_deg, seconds) with abrupt cuts."""
+    from roadgaze.synth import parse_timeline, render_clip
 
-    images = {still: cv2.imread(str(still)) for still, _ in segments}
-    height, width = next(iter(images.values())).shape[:2]
-    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), CLIP_FPS, (width, height))
-    try:
-        for still, seconds in segments:
-            for _ in range(round(seconds * CLIP_FPS)):
-                writer.write(images[still])
-    finally:
-        writer.release()
+    spec = ",".join(f"{yaw_deg:g}:{seconds:g}" for yaw_deg, seconds in segments)
+    render_clip(parse_timeline(spec, transition_s=0.0), path, fps=CLIP_FPS, renderer=renderer)
     return path
 
 
 @pytest.fixture(scope="module")
-def glance_clip(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def glance_clip(tmp_path_factory: pytest.TempPathFactory, synthetic_renderer: Any) -> Path:
+    """Road 4 s, a 45 deg glance to the driver's left for 4 s, road 4 s (roadgaze.synth)."""
     folder = tmp_path_factory.mktemp("clips")
-    return write_clip(folder / "glance.avi", [(FRONTAL, 4.0), (SIDE_45, 4.0), (FRONTAL, 4.0)])
+    return synthetic_clip_file(
+        folder / "glance.avi", synthetic_renderer, [(0.0, 4.0), (45.0, 4.0), (0.0, 4.0)]
+    )
 
 
 @pytest.fixture(scope="module")
-def vats_clip(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def vats_clip(tmp_path_factory: pytest.TempPathFactory, synthetic_renderer: Any) -> Path:
     folder = tmp_path_factory.mktemp("clips")
-    segments = [(FRONTAL, 2.0)] + [(SIDE_45, 2.5), (FRONTAL, 1.0)] * 5 + [(FRONTAL, 1.0)]
-    return write_clip(folder / "vats.avi", segments)
+    segments = [(0.0, 2.0)] + [(45.0, 2.5), (0.0, 1.0)] * 5 + [(0.0, 1.0)]
+    return synthetic_clip_file(folder / "vats.avi", synthetic_renderer, segments)
 
 
 class Hub:
@@ -226,7 +215,6 @@ def replay_publish(clip: Path, port: int, out: Path) -> subprocess.CompletedProc
     return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
 
 
-@needs_data
 @pytest.mark.slow
 def test_replay_publish_one_long_distraction_three_seconds_into_the_glance(
     glance_clip: Path, hub: tuple[Hub, int], tmp_path: Path
@@ -259,7 +247,6 @@ def test_replay_publish_one_long_distraction_three_seconds_into_the_glance(
     assert recorder.of("state")[-1]["status"] == "stopped"
 
 
-@needs_data
 @pytest.mark.slow
 def test_replay_publish_five_short_glances_one_vats_no_long_distraction(
     vats_clip: Path, hub: tuple[Hub, int], tmp_path: Path
@@ -292,7 +279,6 @@ def run_daemon_process(source: str, port: int, *extra: str) -> subprocess.Popen[
     )
 
 
-@needs_data
 @pytest.mark.slow
 def test_daemon_sigterm_publishes_final_state_and_its_token_goes_away(
     glance_clip: Path, hub: tuple[Hub, int]
@@ -321,7 +307,6 @@ def test_daemon_sigterm_publishes_final_state_and_its_token_goes_away(
     assert any("SIGTERM received" in entry["message"] for entry in logs)
 
 
-@needs_data
 @pytest.mark.slow
 def test_daemon_keeps_monitoring_while_the_peer_is_unreachable(glance_clip: Path) -> None:
     port = free_port()
@@ -428,20 +413,17 @@ class Unplugged(FakeCamera):
         return False
 
 
-@needs_data
 @pytest.mark.slow
 def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
-    hub: tuple[Hub, int], monkeypatch: pytest.MonkeyPatch
+    hub: tuple[Hub, int], monkeypatch: pytest.MonkeyPatch, synthetic_renderer: Any
 ) -> None:
     import threading
-
-    import cv2
 
     import roadgaze.capture as capture
     from roadgaze.daemon import StopFlag, run_daemon
 
     recorder, port = hub
-    image = cv2.imread(str(FRONTAL))
+    image = synthetic_renderer.render(0.0)
     # First plug: 60 frames then the camera vanishes; two failed re-opens; then it is back.
     plugs = iter([FakeCamera(image, 60), Unplugged(image, 0), Unplugged(image, 0)])
 

@@ -91,3 +91,31 @@ def test_monitor_stays_quiet_for_short_glances(synthetic_clip: SyntheticClip) ->
         run_pipeline(path, config, [monitor])
     assert monitor.alerts == []
     assert monitor.monitor.state.on_road
+
+
+@pytest.mark.slow
+def test_replay_on_a_synthetic_clip_writes_every_output(
+    synthetic_clip: SyntheticClip, tmp_path: Path
+) -> None:
+    import json
+
+    import cv2
+
+    from roadgaze.cli import main
+
+    path, truth = synthetic_clip("0:1,30:1.5,0:1,-30:1.5")
+    out, table = tmp_path / "frames.jsonl", tmp_path / "frames.csv"
+    plot, video = tmp_path / "yaw.png", tmp_path / "annotated.mp4"
+    arguments = ["replay", str(path), "--out", str(out), "--csv", str(table)]
+    arguments += ["--plot", str(plot), "--annotate", str(video), "--no-progress"]
+    assert main(arguments) == 0
+    records = [json.loads(line) for line in out.read_text().splitlines()]
+    assert [r["frame"] for r in records] == list(range(len(truth)))
+    raw = np.array([r["yaw_raw_deg"] for r in records], dtype=float)
+    holding = np.abs(np.gradient(truth[:, 1])) < 1e-9
+    assert np.max(np.abs(raw - truth[:, 1])[holding]) < 8.0
+    assert len(table.read_text().splitlines()) == len(truth) + 1
+    assert cv2.imread(str(plot)) is not None
+    capture = cv2.VideoCapture(str(video))
+    assert capture.get(cv2.CAP_PROP_FRAME_COUNT) == len(truth)
+    capture.release()

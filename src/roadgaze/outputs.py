@@ -318,7 +318,7 @@ def annotate(
 
     canvas = image.copy()
     height, width = canvas.shape[:2]
-    scale = max(0.35, min(width, height) / 720.0)
+    scale = max(0.45, min(width, height) / 720.0)
     thickness = max(1, round(2 * scale))
     features = sample.features
     if features is not None:

@@ -13,8 +13,11 @@ from __future__ import annotations
 
 import logging
 import math
+import signal
+import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -94,19 +97,26 @@ class StageStats:
 
 
 class StageTimings:
-    """Per-stage times of the most recent `capacity` frames (a fixed ring: memory stays flat)."""
+    """Per-stage times of the most recent `capacity` frames (a fixed ring: memory stays flat).
 
-    def __init__(self, capacity: int = 20_000) -> None:
+    The first `skip_first` frames (model start-up) are not recorded.
+    """
+
+    def __init__(self, capacity: int = 20_000, skip_first: int = 0) -> None:
         self._times_ms: npt.NDArray[np.float64] = np.zeros((capacity, len(STAGES)))
         self._count = 0
+        self._to_skip = skip_first
 
     def add(self, times: StageTimes) -> None:
+        if self._to_skip > 0:
+            self._to_skip -= 1
+            return
         self._times_ms[self._count % len(self._times_ms)] = times.as_tuple()
         self._count += 1
 
     @property
     def count(self) -> int:
-        """Frames recorded in total (may exceed what the ring holds)."""
+        """Frames recorded in total, skipped ones excluded (may exceed what the ring holds)."""
         return self._count
 
     def stats(self) -> dict[str, StageStats]:
@@ -303,3 +313,20 @@ def create_detector(config: Config) -> LandmarkDetector:
     from roadgaze.landmarks import MediaPipeLandmarker
 
     return MediaPipeLandmarker.from_config(config, video=True)
+
+
+@contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM raises KeyboardInterrupt so `with` blocks close every output."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

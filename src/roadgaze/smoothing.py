@@ -56,6 +56,7 @@ class YawSmoother:
         self._rejected_total = 0
         self._reinitialisations = 0
         self._started = False
+        self._model_dt_s = math.nan
 
     def reset(self) -> None:
         """Forget the track; the next measurement starts a new one."""
@@ -92,6 +93,8 @@ class YawSmoother:
             if yaw_deg is None:
                 self._t_s = t_s
                 return None
+            if self._started:
+                self._reinitialisations += 1
             self._start(t_s, yaw_deg)
             return self._estimate()
         assert self._t_s is not None and self._last_measurement_t_s is not None
@@ -138,11 +141,13 @@ class YawSmoother:
         self._consecutive_rejections = 0
 
     def _predict(self, dt_s: float) -> None:
-        transition = np.array([[1.0, dt_s], [0.0, 1.0]])
-        process_noise = Q_discrete_white_noise(
-            dim=2, dt=dt_s, var=self.config.acceleration_std_dps2**2
-        )
-        self._filter.predict(F=transition, Q=process_noise)
+        if dt_s != self._model_dt_s:  # most streams repeat one dt: build F and Q once
+            self._model_dt_s = dt_s
+            self._filter.F = np.array([[1.0, dt_s], [0.0, 1.0]])
+            self._filter.Q = Q_discrete_white_noise(
+                dim=2, dt=dt_s, var=self.config.acceleration_std_dps2**2
+            )
+        self._filter.predict()
 
     def _estimate(self) -> SmoothedYaw:
         x = self._filter.x

@@ -153,6 +153,8 @@ def build_sinks(
 
     extras = extras if extras is not None else record_extras(args, config)
     sinks: list[Sink] = []
+    # A sink that adds record fields (e.g. a monitor) goes here, first, and appends its
+    # field function to `extras`, so the writers below see its verdict on the same sample.
     if args.out is not None:
         target = sys.stdout if args.out == "-" else Path(args.out)
         sinks.append(stack.enter_context(JsonlWriter(target, extras)))
@@ -190,13 +192,14 @@ def run(args: argparse.Namespace) -> int:
     from roadgaze.capture import open_source
     from roadgaze.daemon import publishing_sink
     from roadgaze.errors import ConfigError
-    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.pipeline import Pipeline, create_detector, sigterm_as_interrupt
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
     config = monitor_config(args, config_from_args(args))
     stats = ReplayStats()
     with ExitStack() as stack:
+        stack.enter_context(sigterm_as_interrupt())
         source = stack.enter_context(open_source(args.source, config))
         detector = create_detector(config)
         stack.callback(detector.close)

@@ -33,6 +33,7 @@ from roadgaze.types import Frame
 
 # FFmpeg prints its own complaints about bad files on stderr; we report them as one clear line.
 os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
+os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
 
 log = logging.getLogger(__name__)
 
@@ -486,8 +487,12 @@ def _fourcc(code: str) -> int:
 
 
 def _v4l2_capture(device: int | str) -> VideoCaptureLike:
+    """cv2.VideoCapture on V4L2; `/dev/videoN` is opened as index N (OpenCV's V4L2 backend
+    does not open devices by name)."""
     import cv2
 
+    if isinstance(device, str) and (match := _CAMERA_DEVICE.match(device)):
+        device = int(match.group(1))
     capture: VideoCaptureLike = cv2.VideoCapture(device, cv2.CAP_V4L2)
     return capture
 

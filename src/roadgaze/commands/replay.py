@@ -153,6 +153,8 @@ def build_sinks(
 
     extras = extras if extras is not None else record_extras(args, config)
     sinks: list[Sink] = []
+    # A sink that adds record fields (e.g. a monitor) goes here, first, and appends its
+    # field function to `extras`, so the writers below see its verdict on the same sample.
     if args.out is not None:
         target = sys.stdout if args.out == "-" else Path(args.out)
         sinks.append(stack.enter_context(JsonlWriter(target, extras)))

@@ -1,8 +1,9 @@
 """The monitor+publisher sink, `roadgaze run` and `roadgaze replay --publish` end to end.
 
-End-to-end tests use real MediaPipe on clips built from Pointing'04 stills (Person01, frontal and
-45 deg), a Python router session standing in for zenohd on a free loopback port, and the daemon
-in a subprocess that is always terminated.
+End-to-end tests use real MediaPipe on clips of the synthetic face (roadgaze.synth, so a fresh
+clone runs them) and, where the evaluation data is present, on clips built from Pointing'04
+stills (Person01, frontal and 45 deg); a Python router session stands in for zenohd on a free
+loopback port, and the daemon runs in a subprocess that is always terminated.
 """
 
 from __future__ import annotations
@@ -39,6 +40,9 @@ from zenoh_helpers import LineReader, endpoint, free_port, router, stop_process,
 
 REPO = Path(__file__).resolve().parents[1]
 CLIP_FPS = 15
+STILLS = REPO.parent / "shared" / "data" / "pointing04-dev" / "images" / "Person01"
+FRONTAL = STILLS / "person01146+0+0.jpg"
+SIDE_45 = STILLS / "person01143+0-45.jpg"  # pan -45: yaw +45, turned to the person's left
 SCHEMAS = json_schemas()
 ENV = {**os.environ, "PYTHONPATH": str(REPO / "src"), "GLOG_minloglevel": "2"}
 
@@ -121,20 +125,57 @@ def synthetic_clip_file(path: Path, renderer: Any, segments: list[tuple[float, f
     return path
 
 
+def stills_clip_file(path: Path, segments: list[tuple[float, float]]) -> Path:
+    """An MJPG clip of Pointing'04 Person01 stills (frontal or 45 deg) with abrupt cuts."""
+    import cv2
+
+    if not FRONTAL.is_file():
+        pytest.skip(f"Pointing'04 stills not found under {STILLS} (evaluation data)")
+    images = {0.0: cv2.imread(str(FRONTAL)), 45.0: cv2.imread(str(SIDE_45))}
+    height, width = images[0.0].shape[:2]
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), CLIP_FPS, (width, height))
+    try:
+        for yaw_deg, seconds in segments:
+            for _ in range(round(seconds * CLIP_FPS)):
+                writer.write(images[yaw_deg])
+    finally:
+        writer.release()
+    return path
+
+
+GLANCE = [(0.0, 4.0), (45.0, 4.0), (0.0, 4.0)]
+"""Road 4 s, a 45 deg glance to the driver's left for 4 s, road 4 s."""
+FIVE_GLANCES = [(0.0, 2.0)] + [(45.0, 2.5), (0.0, 1.0)] * 5 + [(0.0, 1.0)]
+
+
 @pytest.fixture(scope="module")
 def glance_clip(tmp_path_factory: pytest.TempPathFactory, synthetic_renderer: Any) -> Path:
-    """Road 4 s, a 45 deg glance to the driver's left for 4 s, road 4 s (roadgaze.synth)."""
+    """The glance rendered from the synthetic face (roadgaze.synth): needs no evaluation data."""
     folder = tmp_path_factory.mktemp("clips")
-    return synthetic_clip_file(
-        folder / "glance.avi", synthetic_renderer, [(0.0, 4.0), (45.0, 4.0), (0.0, 4.0)]
-    )
+    return synthetic_clip_file(folder / "glance.avi", synthetic_renderer, GLANCE)
 
 
-@pytest.fixture(scope="module")
-def vats_clip(tmp_path_factory: pytest.TempPathFactory, synthetic_renderer: Any) -> Path:
-    folder = tmp_path_factory.mktemp("clips")
-    segments = [(0.0, 2.0)] + [(45.0, 2.5), (0.0, 1.0)] * 5 + [(0.0, 1.0)]
-    return synthetic_clip_file(folder / "vats.avi", synthetic_renderer, segments)
+def _clip(
+    request: pytest.FixtureRequest,
+    tmp_path_factory: pytest.TempPathFactory,
+    segments: list[tuple[float, float]],
+) -> Path:
+    path = tmp_path_factory.mktemp("clips") / "clip.avi"
+    if request.param == "pointing04":
+        return stills_clip_file(path, segments)
+    return synthetic_clip_file(path, request.getfixturevalue("synthetic_renderer"), segments)
+
+
+@pytest.fixture(scope="module", params=["synthetic", "pointing04"])
+def glance_clips(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The glance from the synthetic face and from real Pointing'04 stills (skipped without)."""
+    return _clip(request, tmp_path_factory, GLANCE)
+
+
+@pytest.fixture(scope="module", params=["synthetic", "pointing04"])
+def vats_clip(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Five 2.5 s glances with 1 s on road between, synthetic and from Pointing'04 stills."""
+    return _clip(request, tmp_path_factory, FIVE_GLANCES)
 
 
 class Hub:
@@ -217,10 +258,10 @@ def replay_publish(clip: Path, port: int, out: Path) -> subprocess.CompletedProc
 
 @pytest.mark.slow
 def test_replay_publish_one_long_distraction_three_seconds_into_the_glance(
-    glance_clip: Path, hub: tuple[Hub, int], tmp_path: Path
+    glance_clips: Path, hub: tuple[Hub, int], tmp_path: Path
 ) -> None:
     recorder, port = hub
-    result = replay_publish(glance_clip, port, tmp_path / "frames.jsonl")
+    result = replay_publish(glance_clips, port, tmp_path / "frames.jsonl")
     assert result.returncode == 0, result.stderr[-2000:]
     assert wait_for(lambda: len(recorder.of("alert")) >= 2, timeout_s=5.0)
     alerts = recorder.of("alert")

@@ -95,6 +95,20 @@ def test_sink_publishes_every_sample_and_each_alert_in_order() -> None:
     jsonschema.validate(json.loads(link.alerts[0].to_json_bytes()), SCHEMAS["alert"])
 
 
+def test_state_text_for_the_annotated_video_names_gaze_time_and_alerts() -> None:
+    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
+    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), FakeLink(), "test", lambda: 1e9)
+    lines = []
+    for frame in range(121):  # 4 s at 45 deg: long distraction at 3 s
+        t_s = frame / 30
+        sink.on_sample(sample(t_s, 45.0))
+        lines.append(sink.state_text(sample(t_s, 45.0)))
+    assert lines[30] == "gaze off_road  off road 1.0 s  in window 1.0 s"
+    assert lines[90] == (
+        "gaze off_road  off road 3.0 s  in window 3.0 s  ALERT long_distraction:warning"
+    )
+
+
 def test_state_is_degraded_when_the_camera_or_zenoh_is_lost() -> None:
     config = Config()
     link = FakeLink()

@@ -241,6 +241,17 @@ class MonitorPublisher:
         """The monitor's fields for the frame record of `sample` (this sink must run first)."""
         return self.last_extras
 
+    def state_text(self, sample: YawSample) -> str:
+        """One line for an annotated video: the gaze, off-road time and this frame's alerts."""
+        extras = self.last_extras
+        text = f"gaze {extras.get('gaze', '?')}"
+        if extras.get("off_road_s"):
+            text += f"  off road {extras['off_road_s']:.1f} s"
+        text += f"  in window {extras.get('window_off_road_s', 0.0):.1f} s"
+        if extras.get("alerts"):
+            text += "  ALERT " + " ".join(extras["alerts"])
+        return text
+
     def close(self) -> None:
         """Nothing to release: the link is owned by whoever opened it."""
 

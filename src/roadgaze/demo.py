@@ -305,7 +305,7 @@ def run_demo(
             AnnotatedVideoWriter(
                 out_dir / ANNOTATED_NAME,
                 fps,
-                state_text=lambda sample: f"gaze {monitor.last_extras.get('gaze', '?')}",
+                state_text=monitor.state_text,
             )
         )
         sinks: list[Sink] = [monitor, recorder, frames_writer, annotated]

@@ -342,18 +342,34 @@ def annotate(
     lines_text = [_yaw_text(sample), _state_text(sample)]
     if state:
         lines_text.append(state)
-    y = round(height - 12 * scale - (len(lines_text) - 1) * 26 * scale)
-    for text in lines_text:
-        cv2.putText(
-            canvas, text, (round(10 * scale), y), cv2.FONT_HERSHEY_SIMPLEX, 0.7 * scale,
-            (0, 0, 0), thickness + 2, cv2.LINE_AA,
-        )  # fmt: skip
-        cv2.putText(
-            canvas, text, (round(10 * scale), y), cv2.FONT_HERSHEY_SIMPLEX, 0.7 * scale,
-            (255, 255, 255), thickness, cv2.LINE_AA,
-        )  # fmt: skip
-        y += round(26 * scale)
+    _draw_text_panel(canvas, lines_text, scale, thickness)
     return canvas
+
+
+def _draw_text_panel(
+    canvas: npt.NDArray[np.uint8], lines_text: list[str], scale: float, thickness: int
+) -> None:
+    """White text lines at the bottom left on a darkened panel, readable on any background.
+
+    (A black outline drawn with a thicker pen does not work: in OpenCV 5 the glyph advance grows
+    with the thickness, so outline and text drift apart.)
+    """
+    import cv2
+
+    font, font_scale = cv2.FONT_HERSHEY_SIMPLEX, 0.7 * scale
+    line_step = round(26 * scale)
+    margin = round(10 * scale)
+    text_width = max(cv2.getTextSize(t, font, font_scale, thickness)[0][0] for t in lines_text)
+    height, width = canvas.shape[:2]
+    top = max(0, height - margin - line_step * len(lines_text))
+    right = min(width, 2 * margin + text_width)
+    panel = canvas[top:height, 0:right]
+    panel[:] = (panel.astype(np.uint16) * 2 // 5).astype(np.uint8)
+    y = top + line_step - round(6 * scale)
+    for text in lines_text:
+        cv2.putText(canvas, text, (margin, y), font, font_scale, (255, 255, 255), thickness,
+                    cv2.LINE_AA)  # fmt: skip
+        y += line_step
 
 
 def _yaw_text(sample: YawSample) -> str:

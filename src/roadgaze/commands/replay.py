@@ -21,7 +21,7 @@ from roadgaze.commands import common_options, config_from_args
 if TYPE_CHECKING:
     from roadgaze.capture import SourceInfo
     from roadgaze.config import Config
-    from roadgaze.outputs import Extras
+    from roadgaze.outputs import Extras, StateText
     from roadgaze.pipeline import RunSummary, Sink
     from roadgaze.types import YawSample
 
@@ -147,8 +147,12 @@ def build_sinks(
     info: SourceInfo,
     stack: ExitStack,
     extras: list[Extras] | None = None,
+    state_text: StateText | None = None,
 ) -> list[Sink]:
-    """The sinks the options ask for, each registered on `stack` so it is closed at the end."""
+    """The sinks the options ask for, each registered on `stack` so it is closed at the end.
+
+    `state_text` adds a line per frame to the annotated video (the monitor's state).
+    """
     from roadgaze.outputs import AnnotatedVideoWriter, CsvWriter, JsonlWriter, ProgressBar, YawPlot
 
     extras = extras if extras is not None else record_extras(args, config)
@@ -163,7 +167,8 @@ def build_sinks(
     if args.plot is not None:
         sinks.append(stack.enter_context(YawPlot(args.plot, title=Path(info.name).name)))
     if args.annotate is not None:
-        sinks.append(stack.enter_context(AnnotatedVideoWriter(args.annotate, info.fps or 30.0)))
+        writer = AnnotatedVideoWriter(args.annotate, info.fps or 30.0, state_text)
+        sinks.append(stack.enter_context(writer))
     if not args.no_progress:
         total = info.frame_count
         if args.max_frames is not None and total is not None:
@@ -208,7 +213,7 @@ def run(args: argparse.Namespace) -> int:
         sinks: list[Sink] = [
             stats,
             monitor,
-            *build_sinks(args, config, source.info, stack, extras),
+            *build_sinks(args, config, source.info, stack, extras, monitor.state_text),
         ]
         pipeline = Pipeline.from_config(config, detector)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)

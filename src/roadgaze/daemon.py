@@ -149,7 +149,8 @@ class MonitorPublisher:
         connected = self.link.status().connected
         if connected != self._link_connected:
             if connected:
-                log.info("zenoh connected: publishing to subscribers again")
+                again = " again" if self._link_connected is False else ""
+                log.info("zenoh connected: publishing to subscribers%s", again)
             else:
                 log.warning("zenoh not connected: monitoring goes on, state is degraded")
             self._link_connected = connected

@@ -29,7 +29,7 @@ import numpy.typing as npt
 
 from roadgaze.config import CaptureConfig, Config
 from roadgaze.errors import SourceError
-from roadgaze.types import Frame
+from roadgaze.types import ClosesOnExit, Frame
 
 # FFmpeg prints its own complaints about bad files on stderr; we report them as one clear line.
 os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
@@ -112,28 +112,14 @@ class VideoCaptureLike(Protocol):
     def release(self) -> None: ...
 
 
-class _SourceBase:
-    """Context-manager plumbing shared by the sources."""
+class _SourceBase(ClosesOnExit):
+    """What the sources share: a context manager with a `status`."""
 
     _status: SourceStatus
-
-    def close(self) -> None:
-        raise NotImplementedError
 
     @property
     def status(self) -> SourceStatus:
         return self._status
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
 
 
 def _finite_positive(value: float) -> float | None:

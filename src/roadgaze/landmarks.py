@@ -28,14 +28,13 @@ import tempfile
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from types import TracebackType
-from typing import Any, Self
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from roadgaze.config import Config, LandmarksConfig
-from roadgaze.types import Detection, FaceFeatures
+from roadgaze.types import ClosesOnExit, Detection, FaceFeatures
 
 NUM_LANDMARKS = 478
 RIGHT_EYE_OUTER = 33
@@ -405,7 +404,7 @@ def _filtered_native_stderr() -> Iterator[None]:
                 sys.stderr.flush()
 
 
-class MediaPipeLandmarker:
+class MediaPipeLandmarker(ClosesOnExit):
     """MediaPipe FaceLandmarker as a `roadgaze.types.LandmarkDetector`; a context manager.
 
     `video=False`: IMAGE mode, each call independent (`t_s` must be None).
@@ -526,14 +525,3 @@ class MediaPipeLandmarker:
         if self._mirror_landmarker is not None:
             self._mirror_landmarker.close()
             self._mirror_landmarker = None
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()

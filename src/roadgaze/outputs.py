@@ -14,15 +14,14 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from types import TracebackType
-from typing import IO, Any, Self
+from typing import IO, Any
 
 import numpy as np
 import numpy.typing as npt
 
 from roadgaze.errors import RoadgazeError
 from roadgaze.pipeline import ProcessedFrame
-from roadgaze.types import FaceFeatures, YawSample
+from roadgaze.types import ClosesOnExit, FaceFeatures, YawSample
 
 RECORD_FIELDS = (
     "t_s",
@@ -85,20 +84,8 @@ def _open_for_writing(path: Path, what: str, newline: str | None = None) -> IO[s
         raise RoadgazeError(f"cannot write {what} {path}: {exc.strerror or exc}") from None
 
 
-class _Writer:
-    def close(self) -> None:
-        raise NotImplementedError
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
+class _Writer(ClosesOnExit):
+    """Base of the sinks that write a file: context managers closed on exit."""
 
 
 class JsonlWriter(_Writer):

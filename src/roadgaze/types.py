@@ -9,7 +9,8 @@ frames. Image x grows to the right, y downwards. Yaw > 0: head turned to the dri
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
+from types import TracebackType
+from typing import Protocol, Self
 
 import numpy as np
 import numpy.typing as npt
@@ -101,3 +102,21 @@ class LandmarkDetector(Protocol):
     def detect(self, image: npt.NDArray[np.uint8], t_s: float | None = None) -> Detection: ...
 
     def close(self) -> None: ...
+
+
+class ClosesOnExit:
+    """Mixin for resources: `with resource:` returns it and calls `close()` on the way out."""
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
-from types import TracebackType
-from typing import Self
 
 import numpy as np
 import pytest
@@ -14,7 +12,7 @@ from roadgaze.capture import SourceInfo, SourceStatus
 from roadgaze.config import Config
 from roadgaze.geometry import center_ce, forward_model
 from roadgaze.pipeline import STAGES, Pipeline, ProcessedFrame, StageTimes, StageTimings
-from roadgaze.types import Detection, FaceFeatures, Frame, YawSample
+from roadgaze.types import ClosesOnExit, Detection, FaceFeatures, Frame, YawSample
 
 
 def face_at(yaw_deg: float) -> FaceFeatures:
@@ -51,7 +49,7 @@ class ScriptedDetector:
         self.closed = True
 
 
-class ListSource:
+class ListSource(ClosesOnExit):
     """Fake FrameSource over blank frames at `fps`."""
 
     def __init__(self, count: int, fps: float = 30.0) -> None:
@@ -73,17 +71,6 @@ class ListSource:
 
     def close(self) -> None:
         return None
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
 
 
 class Recorder:

@@ -18,6 +18,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from roadgaze.errors import ConfigError
+from roadgaze.geometry import FaceModelConstants
 
 ENV_PREFIX = "ROADGAZE__"
 
@@ -46,6 +47,10 @@ class GeometryConfig(_Section):
     beta: float = Field(default=1.25, gt=1)
     gamma_c: float = Field(default=0.1269, ge=0)
     gamma_b: float = Field(default=0.5774, ge=0)
+
+    def face_constants(self) -> FaceModelConstants:
+        """The constants as the yaw models take them."""
+        return FaceModelConstants(self.alpha, self.beta, self.gamma_c, self.gamma_b)
 
 
 class LandmarksConfig(_Section):

@@ -179,12 +179,7 @@ class Pipeline:
             detector=detector,
             smoother=YawSmoother(config.smoothing),
             yaw_model=YAW_MODELS[geometry.model],
-            constants=FaceModelConstants(
-                alpha=geometry.alpha,
-                beta=geometry.beta,
-                gamma_c=geometry.gamma_c,
-                gamma_b=geometry.gamma_b,
-            ),
+            constants=geometry.face_constants(),
         )
 
     def raw_yaw_deg(self, features: FaceFeatures | None) -> float | None:

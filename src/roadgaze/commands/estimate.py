@@ -33,14 +33,10 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from roadgaze.evaluation import estimate_images
-    from roadgaze.geometry import FaceModelConstants
     from roadgaze.model_store import resolve_model
 
     config = config_from_args(args)
-    geometry = config.geometry
-    constants = FaceModelConstants(
-        geometry.alpha, geometry.beta, geometry.gamma_c, geometry.gamma_b
-    )
+    constants = config.geometry.face_constants()
     model_path = resolve_model(config.model)
     jobs = [(path, str(path)) for path in args.images]
     failures = 0

@@ -69,16 +69,12 @@ def run(args: argparse.Namespace) -> int:
         write_predictions,
         write_report,
     )
-    from roadgaze.geometry import FaceModelConstants
     from roadgaze.landmarks import CANDIDATE_CHOICES
     from roadgaze.model_store import resolve_model
 
     config = config_from_args(args)
     truths, skipped = load_ground_truth(args.dataset)
-    geometry = config.geometry
-    constants = FaceModelConstants(
-        geometry.alpha, geometry.beta, geometry.gamma_c, geometry.gamma_b
-    )
+    constants = config.geometry.face_constants()
     model_path = resolve_model(config.model)
     jobs = [(args.dataset / truth.file, truth.file) for truth in truths]
     estimates = list(

@@ -1,34 +1,21 @@
-"""Shared test fixtures: where the repository and the evaluation data are, subprocess env, and
-synthetic clips of a face turning to known yaws (no data needed)."""
+"""Shared test fixtures: the environment for a child `roadgaze` process, and synthetic clips of a
+face turning to known yaws (no data needed). Paths live in `repo_paths`."""
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[1]
-SRC = REPO / "src"
-SHARED_DATA = REPO.parent / "shared" / "data"
-
-
-@pytest.fixture
-def shared_data() -> Path:
-    """`../shared/data` beside the checkout; the test is skipped where it is absent."""
-    if not SHARED_DATA.is_dir():
-        pytest.skip(f"evaluation data not found at {SHARED_DATA} (only beside the dev checkout)")
-    return SHARED_DATA
+from repo_paths import child_env
 
 
 @pytest.fixture
 def subprocess_env() -> dict[str, str]:
     """Environment for a child `python -m roadgaze`: finds this checkout's sources."""
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
-    return env
+    return child_env()
 
 
 # --- Synthetic ground-truth video (roadgaze.synth): fixtures that need no ../shared data -------

@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 import pytest
 
+from repo_paths import VIDEOS
 from roadgaze.capture import (
     CameraSource,
     ImageFolderSource,
@@ -22,8 +23,6 @@ from roadgaze.capture import (
 )
 from roadgaze.config import CaptureConfig, Config
 from roadgaze.errors import SourceError
-
-VIDEOS = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "videos"
 
 
 def numbered_image(index: int, size: tuple[int, int] = (160, 120)) -> np.ndarray:

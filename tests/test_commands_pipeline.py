@@ -10,9 +10,9 @@ import cv2
 import numpy as np
 import pytest
 
+from repo_paths import VIDEOS
 from roadgaze.cli import main
 
-VIDEOS = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "videos"
 needs_videos = pytest.mark.skipif(
     not VIDEOS.is_dir(), reason="../shared/data/videos not present (evaluation data)"
 )

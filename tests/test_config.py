@@ -6,10 +6,9 @@ from pathlib import Path
 
 import pytest
 
+from repo_paths import REPO
 from roadgaze.config import Config, load_config, parse_overrides
 from roadgaze.errors import ConfigError
-
-REPO = Path(__file__).resolve().parents[1]
 
 
 def test_defaults_are_the_documented_ones() -> None:

@@ -9,7 +9,6 @@ loopback port, and the daemon runs in a subprocess that is always terminated.
 from __future__ import annotations
 
 import json
-import os
 import signal
 import subprocess
 import sys
@@ -23,6 +22,7 @@ import jsonschema
 import pytest
 import zenoh
 
+from repo_paths import POINTING04, child_env
 from roadgaze.capture import SourceStatus
 from roadgaze.config import Config
 from roadgaze.daemon import MonitorPublisher
@@ -38,13 +38,12 @@ from roadgaze.transport import (
 from roadgaze.types import YawSample
 from zenoh_helpers import LineReader, endpoint, free_port, router, stop_process, wait_for
 
-REPO = Path(__file__).resolve().parents[1]
 CLIP_FPS = 15
-STILLS = REPO.parent / "shared" / "data" / "pointing04-dev" / "images" / "Person01"
+STILLS = POINTING04 / "images" / "Person01"
 FRONTAL = STILLS / "person01146+0+0.jpg"
 SIDE_45 = STILLS / "person01143+0-45.jpg"  # pan -45: yaw +45, turned to the person's left
 SCHEMAS = json_schemas()
-ENV = {**os.environ, "PYTHONPATH": str(REPO / "src"), "GLOG_minloglevel": "2"}
+ENV = child_env(GLOG_minloglevel="2")
 
 
 @pytest.fixture(autouse=True)

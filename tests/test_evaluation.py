@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from skimage import data as skimage_data
 
+from repo_paths import POINTING04
 from roadgaze.config import LandmarksConfig, load_config
 from roadgaze.errors import DatasetError
 from roadgaze.evaluation import (
@@ -38,8 +39,6 @@ from roadgaze.evaluation import (
 from roadgaze.landmarks import CANDIDATE_CHOICES, DEFAULT_CHOICE
 from roadgaze.model_store import resolve_model
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
-POINTING04 = REPO_ROOT.parent / "shared" / "data" / "pointing04-dev"
 needs_pointing04 = pytest.mark.skipif(
     not POINTING04.is_dir(), reason=f"evaluation data not found at {POINTING04}"
 )

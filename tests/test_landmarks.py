@@ -14,6 +14,7 @@ import numpy.typing as npt
 import pytest
 from skimage import data as skimage_data
 
+from repo_paths import POINTING04, VIDEOS
 from roadgaze.config import LandmarksConfig, load_config
 from roadgaze.geometry import center_ce
 from roadgaze.landmarks import (
@@ -35,8 +36,6 @@ from roadgaze.landmarks import (
 from roadgaze.model_store import resolve_model
 from roadgaze.types import FaceFeatures
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
-POINTING04 = REPO_ROOT.parent / "shared" / "data" / "pointing04-dev"
 needs_pointing04 = pytest.mark.skipif(
     not POINTING04.is_dir(), reason=f"evaluation data not found at {POINTING04}"
 )
@@ -459,9 +458,6 @@ def test_largest_rule_keeps_the_previous_driver_among_similar_faces() -> None:
     assert choose_driver(bigger, "largest", previous_box_px=bigger[0].box_px) == 1
     # The previous driver is gone: the largest face is chosen afresh.
     assert choose_driver(faces, "largest", previous_box_px=(0.0, 0.0, 20.0, 20.0)) == 1
-
-
-VIDEOS = REPO_ROOT.parent / "shared" / "data" / "videos"
 
 
 @pytest.mark.skipif(not VIDEOS.is_dir(), reason=f"evaluation data not found at {VIDEOS}")

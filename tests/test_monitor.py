@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from collections.abc import Callable
-from pathlib import Path
 
 import pytest
 
+from repo_paths import child_env
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor import (
     Alert,
@@ -314,8 +313,7 @@ def test_monitor_imports_no_heavy_modules() -> None:
         "bad = {'cv2', 'mediapipe', 'zenoh'} & set(sys.modules); "
         "sys.exit(1 if bad else 0)"
     )
-    src = Path(__file__).resolve().parents[1] / "src"
-    env = {**os.environ, "PYTHONPATH": str(src)}
+    env = child_env()
     result = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, timeout=60, env=env, check=False
     )

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 import time
@@ -14,6 +13,7 @@ import jsonschema
 import pytest
 import zenoh
 
+from repo_paths import child_env
 from roadgaze.config import Config, ZenohConfig
 from roadgaze.daemon import MonitorPublisher
 from roadgaze.errors import TransportError
@@ -40,7 +40,6 @@ from zenoh_helpers import (
     wait_for,
 )
 
-REPO = Path(__file__).resolve().parents[1]
 SCHEMAS = json_schemas()
 
 
@@ -185,7 +184,7 @@ def test_subscriber_in_another_process_receives_valid_yaw_and_alert() -> None:
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
-            env={**os.environ, "PYTHONPATH": str(REPO / "src")},
+            env=child_env(),
         )
         try:
             reader = LineReader(listener)

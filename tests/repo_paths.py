@@ -1,0 +1,24 @@
+"""Where the checkout, its sources and the evaluation data are, for every test module.
+
+The evaluation data (`../shared/data`) sits beside the development checkout and in CI; a fresh
+clone does not have it, so tests that need it skip with a reason.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+SRC = REPO / "src"
+SHARED_DATA = REPO.parent / "shared" / "data"
+POINTING04 = SHARED_DATA / "pointing04-dev"
+VIDEOS = SHARED_DATA / "videos"
+
+
+def child_env(**extra: str) -> dict[str, str]:
+    """Environment for a child `python -m roadgaze` that finds this checkout's sources."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
+    env.update(extra)
+    return env

@@ -1,4 +1,4 @@
-"""The monitor+publisher sink, `roadgaze run` and `roadgaze replay --publish` end to end.
+"""`roadgaze run` and `roadgaze replay --publish` end to end, over real Zenoh on loopback.
 
 End-to-end tests use real MediaPipe on clips of the synthetic face (roadgaze.synth, so a fresh
 clone runs them) and, where the evaluation data is present, on clips built from Pointing'04
@@ -14,7 +14,6 @@ import subprocess
 import sys
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -22,20 +21,11 @@ import jsonschema
 import pytest
 import zenoh
 
+from fakes import FakeCamera
 from repo_paths import POINTING04, child_env
-from roadgaze.capture import SourceStatus
 from roadgaze.config import Config
-from roadgaze.daemon import MonitorPublisher
 from roadgaze.logs import setup_logging
-from roadgaze.transport import (
-    AlertMessage,
-    Keys,
-    SpeedInput,
-    TransportStatus,
-    YawMessage,
-    json_schemas,
-)
-from roadgaze.types import YawSample
+from roadgaze.transport import json_schemas
 from zenoh_helpers import LineReader, endpoint, free_port, router, stop_process, wait_for
 
 CLIP_FPS = 15
@@ -50,83 +40,6 @@ ENV = child_env(GLOG_minloglevel="2")
 def fresh_log_handler() -> None:
     """Log to this test's stderr (an earlier in-process CLI test may have left a closed one)."""
     setup_logging()
-
-
-@dataclass
-class FakeLink:
-    yaw: list[YawMessage] = field(default_factory=list)
-    alerts: list[AlertMessage] = field(default_factory=list)
-    connected: bool = True
-    speed: SpeedInput | None = None
-
-    def publish_yaw(self, message: YawMessage) -> None:
-        self.yaw.append(message)
-
-    def publish_alert(self, message: AlertMessage) -> None:
-        self.alerts.append(message)
-
-    def status(self) -> TransportStatus:
-        return TransportStatus(mode="peer", session_open=True, connected=self.connected)
-
-
-def sample(t_s: float, yaw_deg: float | None) -> YawSample:
-    face = yaw_deg is not None
-    return YawSample(t_s, round(t_s * 30), face, yaw_deg, yaw_deg, 0.0, 1.0, n_faces=int(face))
-
-
-def test_sink_publishes_every_sample_and_each_alert_in_order() -> None:
-    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
-    link = FakeLink()
-    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), link, "test", lambda: 1e9)
-    for frame in range(300):  # 1 s ahead, 4 s at 45 deg, 5 s ahead
-        t_s = frame / 30
-        sink.on_sample(sample(t_s, 45.0 if 1.0 <= t_s < 5.0 else 0.0))
-    assert [m.seq for m in link.yaw] == list(range(300))
-    assert [(m.seq, m.kind, m.level) for m in link.alerts] == [
-        (0, "long_distraction", "warning"),
-        (1, "cleared", "info"),
-    ]
-    assert link.alerts[0].t_s == pytest.approx(4.0, abs=1 / 30)
-    assert link.alerts[1].clears == ["long_distraction"]
-    assert link.yaw[40].on_road is False and link.yaw[40].gaze == "off_road"
-    assert sink.last_extras["on_road"] is True
-    jsonschema.validate(json.loads(link.yaw[0].to_json_bytes()), SCHEMAS["yaw"])
-    jsonschema.validate(json.loads(link.alerts[0].to_json_bytes()), SCHEMAS["alert"])
-
-
-def test_state_text_for_the_annotated_video_names_gaze_time_and_alerts() -> None:
-    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
-    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), FakeLink(), "test", lambda: 1e9)
-    lines = []
-    for frame in range(121):  # 4 s at 45 deg: long distraction at 3 s
-        t_s = frame / 30
-        sink.on_sample(sample(t_s, 45.0))
-        lines.append(sink.state_text(sample(t_s, 45.0)))
-    assert lines[30] == "gaze off_road  off road 1.0 s  in window 1.0 s"
-    assert lines[90] == (
-        "gaze off_road  off road 3.0 s  in window 3.0 s  ALERT long_distraction:warning"
-    )
-
-
-def test_state_is_degraded_when_the_camera_or_zenoh_is_lost() -> None:
-    config = Config()
-    link = FakeLink()
-    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), link, "/dev/video0")
-    assert sink.state_message().status == "starting"
-    sink.on_sample(sample(0.0, 0.0))
-    assert (sink.state_message().status, sink.state_message().problems) == ("running", [])
-
-    class LostCamera:
-        status = SourceStatus(connected=False, reconnects=2, message="camera 0 lost; reconnecting")
-
-    sink.source = LostCamera()  # type: ignore[assignment]
-    state = sink.state_message()
-    assert state.status == "degraded"
-    assert state.problems == ["camera 0 lost; reconnecting"]
-    assert (state.source_status, state.camera_reopens) == ("reconnecting", 2)
-    sink.source = None
-    link.connected = False
-    assert sink.state_message().problems == ["zenoh not connected"]
 
 
 def synthetic_clip_file(path: Path, renderer: Any, segments: list[tuple[float, float]]) -> Path:
@@ -435,38 +348,6 @@ def test_run_with_a_missing_file_is_one_line_error(tmp_path: Path) -> None:
     assert stderr.strip().splitlines()[-1].startswith("roadgaze run: error: no video file")
 
 
-class FakeCamera:
-    """A V4L2 stand-in: `frames` reads at about 30 fps, then reads fail (unplugged)."""
-
-    def __init__(self, image: Any, frames: int | None) -> None:
-        self.image, self.frames_left = image, frames
-
-    def isOpened(self) -> bool:  # noqa: N802 (OpenCV's name)
-        return True
-
-    def read(self) -> tuple[bool, Any]:
-        time.sleep(1 / 30)
-        if self.frames_left is not None:
-            if self.frames_left <= 0:
-                return False, None
-            self.frames_left -= 1
-        return True, self.image.copy()
-
-    def get(self, prop_id: int) -> float:
-        return 0.0
-
-    def set(self, prop_id: int, value: float) -> bool:
-        return True
-
-    def release(self) -> None:
-        return None
-
-
-class Unplugged(FakeCamera):
-    def isOpened(self) -> bool:  # noqa: N802
-        return False
-
-
 @pytest.mark.slow
 def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
     hub: tuple[Hub, int], monkeypatch: pytest.MonkeyPatch, synthetic_renderer: Any
@@ -474,19 +355,31 @@ def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
     import threading
 
     import roadgaze.capture as capture
-    from roadgaze.daemon import StopFlag, run_daemon
+    from roadgaze.daemon import run_daemon
+    from roadgaze.signals import StopFlag
 
     recorder, port = hub
     image = synthetic_renderer.render(0.0)
     # First plug: 60 frames then the camera vanishes; two failed re-opens; then it is back.
-    plugs = iter([FakeCamera(image, 60), Unplugged(image, 0), Unplugged(image, 0)])
+    period_s = 1 / 30
+    plugs = iter(
+        [
+            FakeCamera(60, image=image, period_s=period_s),
+            FakeCamera(0, image=image, opened=False),
+            FakeCamera(0, image=image, opened=False),
+        ]
+    )
 
     def factory(device: int | str) -> FakeCamera:
-        return next(plugs, None) or FakeCamera(image, None)
+        return next(plugs, None) or FakeCamera(None, image=image, period_s=period_s)
 
-    def open_fake(spec: str, config: Config | None = None) -> capture.FrameSource:
-        assert config is not None
-        return capture.CameraSource(spec, config.capture, capture_factory=factory)
+    def open_fake(
+        spec: str, config: Config | None = None, *, wait_for_camera: bool = False
+    ) -> capture.FrameSource:
+        assert config is not None and wait_for_camera
+        return capture.CameraSource(
+            spec, config.capture, capture_factory=factory, wait_for_device=True
+        )
 
     monkeypatch.setattr(capture, "open_source", open_fake)
     config = Config.model_validate(
@@ -529,24 +422,3 @@ def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
     )
     assert back["status"] == "running" and back["problems"] == []
     assert recorder.of("state")[-1]["status"] == "stopped"
-
-
-@pytest.mark.parametrize(
-    ("speed_payload", "expected"), [(b'{"kmh": 10}', 0), (b"50", 2), (None, 2)]
-)
-def test_sink_gates_alerts_on_the_speed_received(
-    speed_payload: bytes | None, expected: int
-) -> None:
-    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
-    link = FakeLink(speed=SpeedInput(stale_s=5.0))
-    assert link.speed is not None
-    if speed_payload is not None:
-        link.speed.on_payload(speed_payload)
-    sink = MonitorPublisher(config, Keys.from_config(config.zenoh), link, "test")
-    for frame in range(180):
-        t_s = frame / 30
-        sink.on_sample(sample(t_s, 45.0 if 1.0 <= t_s < 5.0 else 0.0))
-    assert len(link.alerts) == expected
-    state = sink.state_message()
-    assert state.monitor.speed_source == ("waiting" if speed_payload is None else "fresh")
-    assert state.monitor.moving is (expected > 0)

@@ -1,99 +1,29 @@
-"""The loop with a fake detector: samples, stage timings, sinks, pacing; no camera, no MediaPipe."""
+"""The loop with a fake detector: records, stage timings, sinks, pacing, stop; no camera."""
 
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
 
-from roadgaze.capture import SourceInfo, SourceStatus
+from fakes import ListSource, ScriptedDetector, face_at
 from roadgaze.config import Config
-from roadgaze.geometry import center_ce, forward_model
-from roadgaze.pipeline import STAGES, Pipeline, ProcessedFrame, StageTimes, StageTimings
-from roadgaze.types import ClosesOnExit, Detection, FaceFeatures, Frame, YawSample
-
-
-def face_at(yaw_deg: float) -> FaceFeatures:
-    """A face whose boundaries and centre come from the paper's forward model."""
-    projected = forward_model(yaw_deg, half_width_px=80.0, pivot_x_px=320.0)
-    return FaceFeatures(
-        x_left_px=float(projected.x_left),
-        x_right_px=float(projected.x_right),
-        x_center_px=float(projected.x_center),
-        roll_deg=0.0,
-        box_px=(220.0, 140.0, 420.0, 380.0),
-        quality=1.0,
-        landmarks_px=np.zeros((0, 3), np.float32),
-    )
-
-
-class ScriptedDetector:
-    """Fake LandmarkDetector: the true yaw per call (None: no face), checking time order."""
-
-    def __init__(self, yaws_deg: list[float | None]) -> None:
-        self.yaws_deg = list(yaws_deg)
-        self.calls: list[float | None] = []
-        self.closed = False
-
-    def detect(self, image: np.ndarray, t_s: float | None = None) -> Detection:
-        assert t_s is not None and (not self.calls or t_s > (self.calls[-1] or -1.0))
-        yaw_deg = self.yaws_deg[len(self.calls)]
-        self.calls.append(t_s)
-        if yaw_deg is None:
-            return Detection(faces=(), driver_index=None)
-        return Detection(faces=(face_at(yaw_deg),), driver_index=0)
-
-    def close(self) -> None:
-        self.closed = True
-
-
-class ListSource(ClosesOnExit):
-    """Fake FrameSource over blank frames at `fps`."""
-
-    def __init__(self, count: int, fps: float = 30.0) -> None:
-        self.count, self.fps = count, fps
-        self._status = SourceStatus()
-
-    @property
-    def info(self) -> SourceInfo:
-        return SourceInfo("list", False, self.fps, self.count, 64, 48)
-
-    @property
-    def status(self) -> SourceStatus:
-        return self._status
-
-    def __iter__(self) -> Iterator[Frame]:
-        for i in range(self.count):
-            self._status = SourceStatus(frames_delivered=i + 1)
-            yield Frame(index=i, t_s=i / self.fps, image=np.zeros((48, 64, 3), np.uint8))
-
-    def close(self) -> None:
-        return None
+from roadgaze.pipeline import STAGES, Pipeline, StageTimes, StageTimings
+from roadgaze.pose.geometry import center_ce
+from roadgaze.types import Detection, FaceFeatures, Frame, FrameRecord, Gaze
 
 
 class Recorder:
     def __init__(self, name: str, order: list[str]) -> None:
         self.name, self.order = name, order
-        self.samples: list[YawSample] = []
+        self.records: list[FrameRecord] = []
+        self.frames: list[Frame] = []
 
-    def on_sample(self, sample: YawSample) -> None:
-        self.samples.append(sample)
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self.records.append(record)
+        self.frames.append(frame)
         self.order.append(self.name)
-
-    def close(self) -> None:
-        return None
-
-
-class FrameRecorder:
-    def __init__(self, order: list[str]) -> None:
-        self.order = order
-        self.processed: list[ProcessedFrame] = []
-
-    def on_frame(self, processed: ProcessedFrame) -> None:
-        self.processed.append(processed)
-        self.order.append("frames")
 
     def close(self) -> None:
         return None
@@ -103,7 +33,7 @@ def test_process_gives_center_ce_yaw_and_smoothed_yaw() -> None:
     pipeline = Pipeline(ScriptedDetector([20.0, 20.0]))
     frame = Frame(index=0, t_s=0.0, image=np.zeros((4, 4, 3), np.uint8))
     processed = pipeline.process(frame, decode_ms=1.5)
-    sample = processed.sample
+    sample = processed.record.sample
     expected = float(center_ce(*(float(v) for v in vars_of(face_at(20.0)))))
     assert sample.face and sample.n_faces == 1
     assert sample.yaw_raw_deg == pytest.approx(expected)
@@ -112,6 +42,7 @@ def test_process_gives_center_ce_yaw_and_smoothed_yaw() -> None:
     assert vars_of(sample.features) == vars_of(face_at(20.0))
     assert processed.times.decode_ms == 1.5
     assert processed.times.total_ms >= processed.times.landmarks_ms + 1.5
+    assert processed.record.verdict.gaze is Gaze.ON_ROAD and processed.record.alerts == ()
 
 
 def vars_of(face: FaceFeatures) -> tuple[float, float, float]:
@@ -121,7 +52,7 @@ def vars_of(face: FaceFeatures) -> tuple[float, float, float]:
 def test_no_face_samples_predict_then_the_track_is_kept() -> None:
     yaws: list[float | None] = [None, None, 10.0, 10.0, None, None, 10.0]
     pipeline = Pipeline(ScriptedDetector(yaws))
-    samples = [p.sample for p in pipeline.frames(ListSource(len(yaws)))]
+    samples = [p.record.sample for p in pipeline.frames(ListSource(len(yaws)))]
     assert [s.face for s in samples] == [y is not None for y in yaws]
     assert samples[0].yaw_deg is None and samples[0].yaw_raw_deg is None
     assert samples[1].yaw_std_deg is None
@@ -147,20 +78,25 @@ def test_impossible_geometry_counts_as_face_without_yaw() -> None:
             )
             return Detection(faces=(bad,), driver_index=0)
 
-    sample = Pipeline(Impossible([])).frames(ListSource(1)).__next__().sample
+    sample = Pipeline(Impossible([])).frames(ListSource(1)).__next__().record.sample
     assert sample.face and sample.yaw_raw_deg is None and sample.yaw_deg is None
 
 
 def test_run_feeds_sinks_in_order_and_times_every_stage() -> None:
     order: list[str] = []
-    first, frames, last = Recorder("first", order), FrameRecorder(order), Recorder("last", order)
+    first, middle, last = (
+        Recorder("first", order),
+        Recorder("middle", order),
+        Recorder("last", order),
+    )
     pipeline = Pipeline(ScriptedDetector([5.0] * 12))
     timings = StageTimings(skip_first=2)
-    summary = pipeline.run(ListSource(12), [first, frames, last], timings=timings)
+    summary = pipeline.run(ListSource(12), [first, middle, last], timings=timings)
     assert summary.frames == 12 and summary.frames_with_face == 12
-    assert order[:3] == ["first", "frames", "last"] and len(order) == 36
-    assert [s.frame for s in last.samples] == list(range(12))
-    assert frames.processed[3].sample is last.samples[3]
+    assert order[:3] == ["first", "middle", "last"] and len(order) == 36
+    assert [r.frame for r in last.records] == list(range(12))
+    assert middle.records[3] is last.records[3]  # one immutable record per frame
+    assert middle.frames[3].index == 3
     assert timings.count == 10
     assert set(summary.stages) == set(STAGES)
     total = summary.stages["total"].median_ms
@@ -184,7 +120,7 @@ def test_realtime_paces_a_file_at_its_own_rate() -> None:
 def test_stage_timings_ring_keeps_the_most_recent_frames() -> None:
     timings = StageTimings(capacity=4)
     for value in range(10):
-        timings.add(StageTimes(*(float(value),) * 6))
+        timings.add(StageTimes(*(float(value),) * 7))
     stats = timings.stats()
     assert timings.count == 10
     assert stats["total"].median_ms == pytest.approx(7.5)  # frames 6..9
@@ -195,7 +131,48 @@ def test_from_config_uses_the_configured_model_and_constants() -> None:
     config = Config.model_validate({"geometry": {"model": "cylindrical"}})
     pipeline = Pipeline.from_config(config, ScriptedDetector([30.0]))
     face = face_at(30.0)
-    from roadgaze.geometry import cylindrical
+    from roadgaze.pose.geometry import cylindrical
 
-    assert pipeline.raw_yaw_deg(face) == pytest.approx(float(cylindrical(*vars_of(face))))
-    assert pipeline.raw_yaw_deg(None) is None
+    assert pipeline.pose.raw_yaw_deg(face) == pytest.approx(float(cylindrical(*vars_of(face))))
+    assert pipeline.pose.raw_yaw_deg(None) is None
+
+
+def test_the_monitor_is_a_stage_of_the_loop() -> None:
+    """A 4 s glance to 45 deg at 30 fps: the record of the frame 3 s in carries the alert."""
+    yaws: list[float | None] = [45.0 if 30 <= i < 150 else 0.0 for i in range(180)]
+    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
+    pipeline = Pipeline.from_config(config, ScriptedDetector(yaws))
+    records = [p.record for p in pipeline.frames(ListSource(len(yaws)))]
+    raised = [(r.frame, a.label) for r in records for a in r.alerts]
+    off_from = next(r.frame for r in records if r.verdict.gaze is Gaze.OFF_ROAD)
+    assert 30 <= off_from <= 33  # the smoother follows the step within a few frames
+    assert raised[0] == (off_from + 90, "long_distraction:warning")
+    assert [label for _, label in raised] == ["long_distraction:warning", "cleared:info"]
+    assert records[60].verdict.gaze is Gaze.OFF_ROAD
+    assert records[60].verdict.off_road_s == pytest.approx((60 - off_from) / 30)
+
+
+def test_speed_below_the_minimum_gates_the_alerts() -> None:
+    yaws: list[float | None] = [45.0] * 150
+    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
+    pipeline = Pipeline.from_config(config, ScriptedDetector(yaws), speed=lambda: 10.0)
+    records = [p.record for p in pipeline.frames(ListSource(len(yaws)))]
+    assert not any(r.alerts for r in records)
+    assert records[-1].verdict.moving is False and records[-1].verdict.speed_kmh == 10.0
+
+
+def test_a_stop_ends_the_loop_before_the_next_frame() -> None:
+    import threading
+
+    stop = threading.Event()
+
+    class StopAfter:
+        def on_record(self, record: FrameRecord, frame: Frame) -> None:
+            if record.frame == 4:
+                stop.set()
+
+        def close(self) -> None:
+            return None
+
+    pipeline = Pipeline(ScriptedDetector([0.0] * 20))
+    assert pipeline.run(ListSource(20), [StopAfter()], stop=stop).frames == 5

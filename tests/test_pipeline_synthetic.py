@@ -11,40 +11,47 @@ import pytest
 
 from roadgaze.capture import open_source
 from roadgaze.config import Config
-from roadgaze.daemon import publishing_sink
 from roadgaze.monitor import AlertKind
 from roadgaze.pipeline import Pipeline, create_detector
-from roadgaze.types import YawSample
+from roadgaze.types import Frame, FrameRecord, PoseSample
 
 SyntheticClip = Callable[[str], tuple[Path, Any]]
 
 
 class Collect:
     def __init__(self) -> None:
-        self.samples: list[YawSample] = []
+        self.records: list[FrameRecord] = []
 
-    def on_sample(self, sample: YawSample) -> None:
-        self.samples.append(sample)
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self.records.append(record)
 
     def close(self) -> None:
         return None
 
+    @property
+    def samples(self) -> list[PoseSample]:
+        return [record.sample for record in self.records]
 
-def run_pipeline(path: Path, config: Config, sinks: list[Any]) -> list[YawSample]:
+    @property
+    def alerts(self) -> list[Any]:
+        return [alert for record in self.records for alert in record.alerts]
+
+
+def run_pipeline(path: Path, config: Config) -> Collect:
     collect = Collect()
     with open_source(str(path), config) as source:
         detector = create_detector(config)
         try:
-            Pipeline.from_config(config, detector).run(source, [collect, *sinks])
+            Pipeline.from_config(config, detector).run(source, [collect])
         finally:
             detector.close()
-    return collect.samples
+    return collect
 
 
 @pytest.mark.slow
 def test_pipeline_yaw_follows_the_synthetic_truth(synthetic_clip: SyntheticClip) -> None:
     path, truth = synthetic_clip("0:1,30:1.5,0:1,-30:1.5")
-    samples = run_pipeline(path, Config(), [])
+    samples = run_pipeline(path, Config()).samples
     assert len(samples) == len(truth)
     np.testing.assert_allclose([s.t_s for s in samples], truth[:, 0], atol=1e-3)
     assert all(s.face and s.n_faces == 1 for s in samples)
@@ -68,8 +75,8 @@ def test_monitor_raises_long_distraction_when_the_glance_lasts(
 ) -> None:
     path, truth = synthetic_clip("0:1.5,40:4,0:1.5")
     config = Config()
-    with publishing_sink(config, str(path), publish=False) as monitor:
-        samples = run_pipeline(path, config, [monitor])
+    monitor = run_pipeline(path, config)
+    samples = monitor.samples
     kinds = [alert.kind for alert in monitor.alerts]
     assert kinds == [AlertKind.LONG_DISTRACTION, AlertKind.CLEARED]
     # Off road once the estimate leaves the 25 deg road band: truth reaches ~25 deg mid-turn.
@@ -87,10 +94,9 @@ def test_monitor_raises_long_distraction_when_the_glance_lasts(
 def test_monitor_stays_quiet_for_short_glances(synthetic_clip: SyntheticClip) -> None:
     path, _ = synthetic_clip("0:1,35:1.2,0:1,-35:1.2,0:1")
     config = Config()
-    with publishing_sink(config, str(path), publish=False) as monitor:
-        run_pipeline(path, config, [monitor])
+    monitor = run_pipeline(path, config)
     assert monitor.alerts == []
-    assert monitor.monitor.state.on_road
+    assert monitor.records[-1].verdict.on_road
 
 
 @pytest.mark.slow

@@ -13,12 +13,14 @@ import os
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from roadgaze.errors import ConfigError
-from roadgaze.geometry import FaceModelConstants
+
+if TYPE_CHECKING:
+    from roadgaze.pose.geometry import FaceModelConstants
 
 ENV_PREFIX = "ROADGAZE__"
 
@@ -40,7 +42,7 @@ class ModelConfig(_Section):
 
 
 class GeometryConfig(_Section):
-    """The face model turning boundaries and centre into yaw (see PAPER.md)."""
+    """The face model turning boundaries and centre into yaw (Narayanan et al. 2014)."""
 
     model: Literal["cylindrical", "ellipsoidal", "ce", "center_ce", "boundary_ce"] = "center_ce"
     alpha: float = Field(default=0.25, ge=0)
@@ -50,6 +52,8 @@ class GeometryConfig(_Section):
 
     def face_constants(self) -> FaceModelConstants:
         """The constants as the yaw models take them."""
+        from roadgaze.pose.geometry import FaceModelConstants
+
         return FaceModelConstants(self.alpha, self.beta, self.gamma_c, self.gamma_b)
 
 

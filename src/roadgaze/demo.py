@@ -2,7 +2,7 @@
 
 One run, no camera and no video needed: the astronaut photo (or `photo`) is turned through a short
 drive (road, one long glance away, a few short ones, road again) by `roadgaze.synth`; the service
-(`roadgaze.pipeline` + `roadgaze.daemon.publishing_sink`: landmarks, Center-CE, Kalman smoother,
+(`roadgaze.pipeline` + `roadgaze.daemon.bus_outputs`: landmarks, Center-CE, Kalman smoother,
 monitor, Zenoh publisher on 127.0.0.1) runs over the clip as fast as it can; a second Zenoh session,
 connected to the first over loopback, subscribes to the alert key and reports each alert as it
 arrives. The output folder then holds the clip and its truth, the per-frame records, the received
@@ -27,8 +27,7 @@ import numpy as np
 
 from roadgaze.config import Config
 from roadgaze.errors import RoadgazeError
-from roadgaze.synth import FloatArray, Timeline, parse_timeline, write_truth_csv
-from roadgaze.types import YawSample
+from roadgaze.synth import Timeline, parse_timeline, truth_path_for, write_truth_csv
 
 log = logging.getLogger(__name__)
 
@@ -170,64 +169,6 @@ class AlertSubscriber:
             self._file.close()
 
 
-class DriveRecorder:
-    """Sample sink collecting truth-aligned yaw and the monitor's alerts for the demo's plot."""
-
-    def __init__(self) -> None:
-        self.t_s: list[float] = []
-        self.raw_deg: list[float] = []
-        self.smoothed_deg: list[float] = []
-
-    def on_sample(self, sample: YawSample) -> None:
-        self.t_s.append(sample.t_s)
-        self.raw_deg.append(math.nan if sample.yaw_raw_deg is None else sample.yaw_raw_deg)
-        self.smoothed_deg.append(math.nan if sample.yaw_deg is None else sample.yaw_deg)
-
-    def close(self) -> None:
-        return None
-
-
-def save_drive_plot(
-    path: Path,
-    truth: FloatArray,
-    recorder: DriveRecorder,
-    alerts: list[Any],
-    road_half_width_deg: float,
-) -> None:
-    """PNG of truth, raw and smoothed yaw over time, the road band and each alert marked."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    figure, axes = plt.subplots(figsize=(10, 4.5), dpi=110)
-    axes.axhspan(-road_half_width_deg, road_half_width_deg, color="tab:green", alpha=0.08)
-    axes.plot(truth[:, 0], truth[:, 1], "-", color="black", linewidth=1.2, label="truth")
-    axes.plot(recorder.t_s, recorder.raw_deg, ".", color="tab:gray", markersize=3, label="raw")
-    axes.plot(recorder.t_s, recorder.smoothed_deg, "-", color="tab:blue", label="smoothed")
-    colours = {"warning": "tab:orange", "critical": "tab:red", "info": "tab:green"}
-    top = axes.get_ylim()[1]
-    for alert in alerts:
-        colour = colours.get(alert.level.value, "tab:purple")
-        axes.axvline(alert.t_s, color=colour, linestyle="--", linewidth=1)
-        axes.text(
-            alert.t_s, top, f" {alert.kind.value}", rotation=90, va="top", fontsize=7, color=colour
-        )
-    axes.set_xlabel("time (s)")
-    axes.set_ylabel("yaw (deg, + = driver's left)")
-    axes.set_title("roadgaze demo: synthetic drive (green band: road ahead)")
-    axes.legend(loc="lower left", fontsize=8)
-    axes.grid(alpha=0.3)
-    figure.tight_layout()
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        figure.savefig(path)
-    except OSError as exc:
-        raise RoadgazeError(f"cannot write plot {path}: {exc.strerror or exc}") from None
-    finally:
-        plt.close(figure)
-
-
 def format_alert(message: dict[str, Any]) -> str:
     """One line for an alert message as received."""
     if "kind" not in message:
@@ -258,9 +199,9 @@ def run_demo(
     was written before an error stays in `out_dir`.
     """
     from roadgaze.capture import open_source
-    from roadgaze.daemon import publishing_sink
-    from roadgaze.outputs import AnnotatedVideoWriter, JsonlWriter
-    from roadgaze.pipeline import Pipeline, Sink, create_detector
+    from roadgaze.daemon import bus_outputs
+    from roadgaze.outputs import AnnotatedVideoWriter, JsonlWriter, YawPlot
+    from roadgaze.pipeline import Pipeline, create_detector
     from roadgaze.synth import FaceRenderer, load_photo, render_clip
 
     started = time.perf_counter()
@@ -280,46 +221,42 @@ def run_demo(
     truth = render_clip(timeline, video_path, fps=fps, renderer=renderer)
     truth_csv = out_dir / TRUTH_NAME
     write_truth_csv(truth_csv, truth)
-    video_path.with_name(video_path.stem + ".truth.csv").unlink(missing_ok=True)
+    truth_path_for(video_path).unlink(missing_ok=True)
     rendered = time.perf_counter()
 
     port = free_local_port()
     config = demo_config(config, port)
-    recorder = DriveRecorder()
+    plot_path = out_dir / PLOT_NAME
+    plot = YawPlot(
+        plot_path,
+        title="roadgaze demo: synthetic drive (green band: road ahead)",
+        truth=truth,
+        road_half_width_deg=config.monitor.road_half_width_deg,
+    )
     progress(f"running the service over {VIDEO_NAME}, Zenoh on tcp/127.0.0.1:{port}")
     with ExitStack() as stack:
+        stack.enter_context(plot)
         source = stack.enter_context(open_source(str(video_path), config))
         detector = create_detector(config)
         stack.callback(detector.close)
-        monitor = stack.enter_context(publishing_sink(config, str(video_path), publish=True))
+        bus = stack.enter_context(bus_outputs(config, str(video_path), publish=True))
         subscriber = AlertSubscriber(
             subscriber_config(config, port), out_dir / ALERTS_NAME, on_alert
         )
         stack.callback(subscriber.close)
         if not subscriber.wait_for_publisher(SUBSCRIBER_WAIT_S):
             log.warning("the subscriber did not see the publisher within %.0f s", SUBSCRIBER_WAIT_S)
-        frames_writer = stack.enter_context(
-            JsonlWriter(out_dir / FRAMES_NAME, extras=[monitor.extras])
-        )
-        annotated = stack.enter_context(
-            AnnotatedVideoWriter(
-                out_dir / ANNOTATED_NAME,
-                fps,
-                state_text=monitor.state_text,
-            )
-        )
-        sinks: list[Sink] = [monitor, recorder, frames_writer, annotated]
-        summary = Pipeline.from_config(config, detector).run(source, sinks)
-        raised = len(monitor.alerts)
+        frames_writer = stack.enter_context(JsonlWriter(out_dir / FRAMES_NAME))
+        annotated = stack.enter_context(AnnotatedVideoWriter(out_dir / ANNOTATED_NAME, fps))
+        pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
+        summary = pipeline.run(source, [*bus.sinks, plot, frames_writer, annotated])
+        raised = bus.health.alerts_raised
         if not subscriber.wait_for_count(raised, SUBSCRIBER_WAIT_S):
             log.warning("the subscriber received %d of %d alerts", len(subscriber.received), raised)
         received = tuple(subscriber.received)
-        alerts = list(monitor.alerts)
     served = time.perf_counter()
 
-    plot_path = out_dir / PLOT_NAME
-    save_drive_plot(plot_path, truth, recorder, alerts, config.monitor.road_half_width_deg)
-    smoothed = np.asarray(recorder.smoothed_deg)
+    smoothed = np.asarray(plot.smoothed_deg)
     count = min(len(smoothed), len(truth))
     errors = np.abs(smoothed[:count] - truth[:count, 1])
     finite = errors[np.isfinite(errors)]

@@ -1,39 +1,58 @@
-"""The one loop: frame source -> landmarks -> geometry -> smoother -> sinks, timed per stage.
+"""The only loop: frame source -> landmarks -> pose -> monitor -> sinks, timed per stage.
 
-`Pipeline.process(frame)` turns one frame into a `YawSample` (testable with a fake detector and
-no camera); `Pipeline.frames(source)` is the loop as an iterator; `Pipeline.run(source, sinks)`
-drives it and hands every sample to the sinks in the order given. A sink is a `SampleSink`
-(`on_sample(sample)`, `close()`) or, when it also needs the image and timings (an annotated
-video), a `FrameSink` (`on_frame(processed)`, `close()`). Monitors, publishers and writers plug in
-as sinks without changing the loop; a sink placed earlier runs first, so a JSONL writer placed
-after a monitor sink can read the monitor's verdict on the same sample.
+`Pipeline.process(frame)` turns one frame into a `FrameRecord` (testable with a fake detector
+and no camera); `Pipeline.frames(source)` is the loop as an iterator; `Pipeline.run(source,
+sinks, stop=...)` drives it and hands every record, with its frame, to each sink. `run`,
+`replay`, `demo` and `bench` all use this loop; a sink only reads the record, so sinks are
+independent of each other and of their order.
 """
 
 from __future__ import annotations
 
-import logging
 import math
-import signal
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from roadgaze.capture import FrameSource, SourceStatus
 from roadgaze.config import Config
-from roadgaze.geometry import YAW_MODELS, FaceModelConstants, YawModel
-from roadgaze.smoothing import YawSmoother
-from roadgaze.types import Detection, FaceFeatures, Frame, LandmarkDetector, YawSample
+from roadgaze.monitor import Monitor
+from roadgaze.pose import PoseEstimator
+from roadgaze.types import Frame, FrameRecord, LandmarkDetector
 
-log = logging.getLogger(__name__)
-
-STAGES = ("decode", "landmarks", "geometry", "smoothing", "sinks", "total")
+STAGES = ("decode", "landmarks", "geometry", "smoothing", "monitor", "sinks", "total")
 """Timed stages; `total` is one whole loop iteration, from asking for the frame to the last sink."""
+
+STOP_GRACE_S = 1.0
+"""After a stop is asked for, how long the frame in hand may take before a live source is closed
+(which unblocks a loop waiting for a lost camera)."""
+
+SpeedSource = Callable[[], float | None]
+"""The vehicle speed in km/h for the monitor; None when unknown (taken as moving)."""
+
+
+def no_speed() -> float | None:
+    """The speed source of a replay without a bus: always unknown, i.e. moving (fail-safe)."""
+    return None
+
+
+class StopSignal(Protocol):
+    """Anything with `is_set()`: a `threading.Event`, the daemon's `StopFlag`."""
+
+    def is_set(self) -> bool: ...
+
+
+class Sink(Protocol):
+    """Receives every record, in order, with its frame; `close()` once at the end."""
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None: ...
+
+    def close(self) -> None: ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -45,6 +64,7 @@ class StageTimes:
     landmarks_ms: float
     geometry_ms: float
     smoothing_ms: float
+    monitor_ms: float
     sinks_ms: float
     total_ms: float
 
@@ -54,6 +74,7 @@ class StageTimes:
             self.landmarks_ms,
             self.geometry_ms,
             self.smoothing_ms,
+            self.monitor_ms,
             self.sinks_ms,
             self.total_ms,
         )
@@ -61,33 +82,12 @@ class StageTimes:
 
 @dataclass(frozen=True, slots=True)
 class ProcessedFrame:
-    """One frame and everything the pipeline made of it."""
+    """One frame, its record and how long each stage took."""
 
     frame: Frame
-    detection: Detection
-    sample: YawSample
+    record: FrameRecord
     times: StageTimes
-    """Before the sinks ran, `sinks_ms` is 0 and `total_ms` ends after smoothing."""
-
-
-class SampleSink(Protocol):
-    """Receives every sample in order; `close()` once at the end (also after an error)."""
-
-    def on_sample(self, sample: YawSample) -> None: ...
-
-    def close(self) -> None: ...
-
-
-@runtime_checkable
-class FrameSink(Protocol):
-    """A sink that also needs the image, the detection or the timings of each frame."""
-
-    def on_frame(self, processed: ProcessedFrame) -> None: ...
-
-    def close(self) -> None: ...
-
-
-Sink = SampleSink | FrameSink
+    """Before the sinks ran, `sinks_ms` is 0 and `total_ms` ends after the monitor."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -156,74 +156,56 @@ class RunSummary:
 
 
 class Pipeline:
-    """Landmarks -> geometry -> smoother for one stream; one instance per source."""
+    """Landmarks -> pose -> monitor for one stream; one instance per source timeline."""
 
     def __init__(
         self,
         detector: LandmarkDetector,
-        smoother: YawSmoother | None = None,
-        yaw_model: YawModel = YAW_MODELS["center_ce"],
-        constants: FaceModelConstants | None = None,
+        pose: PoseEstimator | None = None,
+        monitor: Monitor | None = None,
+        speed: SpeedSource = no_speed,
         clock: Callable[[], float] = time.perf_counter,
     ) -> None:
         self.detector = detector
-        self.smoother = smoother if smoother is not None else YawSmoother()
-        self.yaw_model = yaw_model
-        self.constants = constants if constants is not None else FaceModelConstants()
+        self.pose = pose if pose is not None else PoseEstimator()
+        self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
+        self.speed = speed
         self._clock = clock
 
     @classmethod
-    def from_config(cls, config: Config, detector: LandmarkDetector) -> Pipeline:
-        geometry = config.geometry
+    def from_config(
+        cls, config: Config, detector: LandmarkDetector, speed: SpeedSource = no_speed
+    ) -> Pipeline:
         return cls(
             detector=detector,
-            smoother=YawSmoother(config.smoothing),
-            yaw_model=YAW_MODELS[geometry.model],
-            constants=geometry.face_constants(),
+            pose=PoseEstimator.from_config(config),
+            monitor=Monitor(config.monitor),
+            speed=speed,
         )
-
-    def raw_yaw_deg(self, features: FaceFeatures | None) -> float | None:
-        """The configured yaw model on one face; None without a face or for impossible geometry."""
-        if features is None:
-            return None
-        yaw_deg = float(
-            self.yaw_model(
-                features.x_left_px, features.x_right_px, features.x_center_px, self.constants
-            )
-        )
-        return yaw_deg if math.isfinite(yaw_deg) else None
 
     def process(self, frame: Frame, decode_ms: float = 0.0) -> ProcessedFrame:
-        """One frame through landmarks, geometry and smoother; frames must come in time order."""
+        """One frame through every stage; frames must come in time order."""
         clock = self._clock
         start = clock()
         detection = self.detector.detect(frame.image, frame.t_s)
         after_landmarks = clock()
-        features = detection.driver
-        yaw_raw_deg = self.raw_yaw_deg(features)
+        yaw_raw_deg = self.pose.raw_yaw_deg(detection.driver)
         after_geometry = clock()
-        smoothed = self.smoother.update(frame.t_s, yaw_raw_deg)
+        sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg)
         after_smoothing = clock()
-        sample = YawSample(
-            t_s=frame.t_s,
-            frame=frame.index,
-            face=features is not None,
-            yaw_raw_deg=yaw_raw_deg,
-            yaw_deg=None if smoothed is None else smoothed.yaw_deg,
-            yaw_rate_dps=None if smoothed is None else smoothed.yaw_rate_dps,
-            yaw_std_deg=None if smoothed is None else smoothed.yaw_std_deg,
-            features=features,
-            n_faces=len(detection.faces),
-        )
+        alerts = self.monitor.update(sample, self.speed())
+        record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)
+        after_monitor = clock()
         times = StageTimes(
             decode_ms=decode_ms,
             landmarks_ms=(after_landmarks - start) * 1e3,
             geometry_ms=(after_geometry - after_landmarks) * 1e3,
             smoothing_ms=(after_smoothing - after_geometry) * 1e3,
+            monitor_ms=(after_monitor - after_smoothing) * 1e3,
             sinks_ms=0.0,
-            total_ms=decode_ms + (after_smoothing - start) * 1e3,
+            total_ms=decode_ms + (after_monitor - start) * 1e3,
         )
-        return ProcessedFrame(frame=frame, detection=detection, sample=sample, times=times)
+        return ProcessedFrame(frame=frame, record=record, times=times)
 
     def frames(
         self,
@@ -231,8 +213,10 @@ class Pipeline:
         *,
         realtime: bool = False,
         max_frames: int | None = None,
+        stop: StopSignal | None = None,
     ) -> Iterator[ProcessedFrame]:
-        """The loop as an iterator. `realtime` paces a file source at its own timeline."""
+        """The loop as an iterator. `realtime` paces a file source at its own timeline; `stop`
+        ends the loop before the next frame."""
         clock = self._clock
         iterator = iter(source)
         pace = realtime and not source.info.live
@@ -240,6 +224,8 @@ class Pipeline:
         wall_start = 0.0
         produced = 0
         while max_frames is None or produced < max_frames:
+            if stop is not None and stop.is_set():
+                return
             before = clock()
             frame = next(iterator, None)
             decode_ms = (clock() - before) * 1e3
@@ -262,38 +248,46 @@ class Pipeline:
         realtime: bool = False,
         max_frames: int | None = None,
         timings: StageTimings | None = None,
+        stop: StopSignal | None = None,
     ) -> RunSummary:
-        """Drive the loop to the end of the source, feeding every sink; sinks are not closed here.
-
-        Stage times go into `timings` (a fresh `StageTimings` when None) and the summary.
-        """
+        """Drive the loop to the end of the source or a stop, feeding every sink; sinks are not
+        closed here. Stage times go into `timings` (a fresh `StageTimings` when None) and the
+        summary. A live source still blocked `STOP_GRACE_S` after a stop is closed."""
         timings = timings if timings is not None else StageTimings()
         clock = self._clock
-        wants_frame = [isinstance(sink, FrameSink) for sink in sinks]
         frames = 0
         with_face = 0
-        wall_start = clock()
-        for processed in self.frames(source, realtime=realtime, max_frames=max_frames):
-            before_sinks = clock()
-            for sink, wants in zip(sinks, wants_frame, strict=True):
-                if wants:
-                    sink.on_frame(processed)  # type: ignore[union-attr]
-                else:
-                    sink.on_sample(processed.sample)  # type: ignore[union-attr]
-            sinks_ms = (clock() - before_sinks) * 1e3
-            times = processed.times
-            timings.add(
-                StageTimes(
-                    decode_ms=times.decode_ms,
-                    landmarks_ms=times.landmarks_ms,
-                    geometry_ms=times.geometry_ms,
-                    smoothing_ms=times.smoothing_ms,
-                    sinks_ms=sinks_ms,
-                    total_ms=times.total_ms + sinks_ms,
-                )
+        done = threading.Event()
+        if stop is not None and source.info.live:
+            watcher = threading.Thread(
+                target=_close_when_stopped, args=(stop, source, done), daemon=True
             )
-            frames += 1
-            with_face += processed.sample.face
+            watcher.start()
+        wall_start = clock()
+        try:
+            for processed in self.frames(
+                source, realtime=realtime, max_frames=max_frames, stop=stop
+            ):
+                before_sinks = clock()
+                for sink in sinks:
+                    sink.on_record(processed.record, processed.frame)
+                sinks_ms = (clock() - before_sinks) * 1e3
+                times = processed.times
+                timings.add(
+                    StageTimes(
+                        decode_ms=times.decode_ms,
+                        landmarks_ms=times.landmarks_ms,
+                        geometry_ms=times.geometry_ms,
+                        smoothing_ms=times.smoothing_ms,
+                        monitor_ms=times.monitor_ms,
+                        sinks_ms=sinks_ms,
+                        total_ms=times.total_ms + sinks_ms,
+                    )
+                )
+                frames += 1
+                with_face += processed.record.sample.face
+        finally:
+            done.set()
         return RunSummary(
             frames=frames,
             frames_with_face=with_face,
@@ -303,25 +297,17 @@ class Pipeline:
         )
 
 
+def _close_when_stopped(stop: StopSignal, source: FrameSource, done: threading.Event) -> None:
+    """Unblock a loop that waits for a lost camera once a stop is asked for."""
+    while not done.wait(0.1):
+        if stop.is_set():
+            if not done.wait(STOP_GRACE_S):  # the frame in hand had its grace period
+                source.close()
+            return
+
+
 def create_detector(config: Config) -> LandmarkDetector:
     """The production detector: MediaPipe FaceLandmarker in VIDEO mode (model via model_store)."""
     from roadgaze.landmarks import MediaPipeLandmarker
 
     return MediaPipeLandmarker.from_config(config, video=True)
-
-
-@contextmanager
-def sigterm_as_interrupt() -> Iterator[None]:
-    """Within the block, SIGTERM raises KeyboardInterrupt so `with` blocks close every output."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def interrupt(signum: int, frame: object) -> None:
-        raise KeyboardInterrupt(f"signal {signum}")
-
-    previous = signal.signal(signal.SIGTERM, interrupt)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)

@@ -1,19 +1,27 @@
-"""Frozen dataclasses that flow between the pipeline stages.
+"""The frozen records that flow between the stages, one per frame, and the shared vocabulary.
 
 Every per-frame object carries `t_s`, the time on the source's timeline (container time for a
 video file, seconds since start for a live camera), so time-based logic counts seconds, not
 frames. Image x grows to the right, y downwards. Yaw > 0: head turned to the driver's own left
 (ISO 8855), which an unmirrored camera sees as the nose pointing to the image right.
+
+A frame travels as: `Frame` (capture) -> `Detection` of `FaceFeatures` (landmarks) ->
+`PoseSample` (pose: the yaw model and the smoother) -> `FrameRecord` (the monitor adds its
+`Verdict` and the `Alert`s raised on that frame). Writers, the annotator and the Zenoh publisher
+read the `FrameRecord`; nothing travels beside it.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import StrEnum
 from types import TracebackType
 from typing import Protocol, Self
 
 import numpy as np
 import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,20 +84,113 @@ class SmoothedYaw:
 
 
 @dataclass(frozen=True, slots=True)
-class YawSample:
-    """The pipeline's per-frame result."""
+class PoseSample:
+    """What the landmark and pose stages made of one frame: the monitor's input."""
 
     t_s: float
     frame: int
     face: bool
     yaw_raw_deg: float | None
-    """Center-CE yaw of this frame; None without a face or when the model cannot explain it."""
+    """Yaw model output of this frame; None without a face or when the model cannot explain it."""
     yaw_deg: float | None
     """Smoothed yaw; None before the first face or after the track was dropped."""
     yaw_rate_dps: float | None
     yaw_std_deg: float | None
     features: FaceFeatures | None = None
     n_faces: int = 0
+
+
+class AlertKind(StrEnum):
+    """What an alert is about (definitions: docs/monitor.md)."""
+
+    LONG_DISTRACTION = "long_distraction"
+    VATS = "vats"
+    DRIVER_UNAVAILABLE = "driver_unavailable"
+    CLEARED = "cleared"
+
+
+class AlertLevel(StrEnum):
+    INFO = "info"
+    WARNING = "warning"
+    CRITICAL = "critical"
+
+
+class Gaze(StrEnum):
+    """Where the driver looks at one frame."""
+
+    ON_ROAD = "on_road"
+    OFF_ROAD = "off_road"
+    UNKNOWN = "unknown"
+    """No face, and the loss is not explained by a turn away."""
+
+
+@dataclass(frozen=True, slots=True)
+class Alert:
+    """One monitor event, stamped on the source timeline."""
+
+    kind: AlertKind
+    level: AlertLevel
+    t_s: float
+    yaw_deg: float | None
+    """Yaw relative to the camera (not to neutral) at the event; None without a face."""
+    off_road_s: float
+    """Length of the current continuous off-road episode (for `cleared`: of the one just ended)."""
+    window_off_road_s: float
+    """Off-road time within the last `vats_window_s`."""
+    unavailable_s: float = 0.0
+    """How long the driver has been unavailable (face lost, not turned away)."""
+    speed_kmh: float | None = None
+    clears: tuple[AlertKind, ...] = ()
+    """For `cleared`: the kinds of alert that were active."""
+
+    @property
+    def label(self) -> str:
+        """`kind:level`, e.g. `long_distraction:warning`."""
+        return f"{self.kind.value}:{self.level.value}"
+
+
+@dataclass(frozen=True, slots=True)
+class Verdict:
+    """The monitor's view after one frame."""
+
+    gaze: Gaze
+    on_road: bool | None
+    """Road ahead; None when the gaze is unknown (no face, not explained by a turn away)."""
+    yaw_deg: float | None
+    """The yaw judged (smoothed, else raw); None without a face or a usable yaw."""
+    neutral_yaw_deg: float
+    """The road-ahead yaw the monitor measures against (fixed or learned)."""
+    off_road_s: float
+    """Length of the current counted (off road and moving) episode."""
+    window_off_road_s: float
+    """Counted off-road time within the VATS window."""
+    unavailable_s: float
+    vats_armed: bool
+    moving: bool
+    """Faster than the minimum speed, or speed unknown (fail-safe)."""
+    speed_kmh: float | None
+    """The speed used for this frame; None when unknown."""
+    active: tuple[AlertKind, ...]
+    """Alerts raised and not yet cleared, in the order they were raised."""
+    alert_counts: tuple[tuple[str, int], ...] = ()
+    """Alerts raised so far by `kind:level`, sorted."""
+
+
+@dataclass(frozen=True, slots=True)
+class FrameRecord:
+    """One frame as every consumer sees it: the pose sample, the verdict, the alerts raised."""
+
+    sample: PoseSample
+    verdict: Verdict
+    alerts: tuple[Alert, ...] = ()
+
+    @property
+    def t_s(self) -> float:
+        return self.sample.t_s
+
+    @property
+    def frame(self) -> int:
+        return self.sample.frame
 
 
 class LandmarkDetector(Protocol):

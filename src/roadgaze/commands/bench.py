@@ -8,10 +8,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-from roadgaze.commands import common_options, config_from_args
-from roadgaze.types import YawSample
-
-ORDER = 35
+from roadgaze.commands.options import common_options
+from roadgaze.config import Config
+from roadgaze.types import Frame, FrameRecord
 
 
 def register(subparsers: Any) -> None:
@@ -68,7 +67,7 @@ class MemoryProbe:
         self.last_mb = resident_mb()
         self.peak_mb = self.last_mb
 
-    def on_sample(self, sample: YawSample) -> None:
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
         now = time.monotonic()
         if now < self._next:
             return
@@ -86,7 +85,7 @@ class MemoryProbe:
         return None if self.baseline_mb is None else self.last_mb - self.baseline_mb
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     from contextlib import closing
 
     from roadgaze.capture import FrameSource, LoopingSource, VideoFileSource, open_source
@@ -97,7 +96,6 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--warmup must be >= 0, found {args.warmup}")
     if args.loop_seconds is not None and args.loop_seconds <= 0:
         raise ConfigError(f"--loop-seconds must be > 0, found {args.loop_seconds}")
-    config = config_from_args(args)
     rss_start_mb = resident_mb()
     source: FrameSource
     if args.loop_seconds is not None:

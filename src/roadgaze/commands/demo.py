@@ -7,9 +7,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from roadgaze.commands import common_options, config_from_args
-
-ORDER = 1
+from roadgaze.commands.options import common_options
+from roadgaze.config import Config
 
 
 def register(subparsers: Any) -> None:
@@ -41,11 +40,10 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.demo import format_alert, run_demo
     from roadgaze.synth import parse_timeline
 
-    config = config_from_args(args)
     timeline = None if args.timeline is None else parse_timeline(args.timeline)
 
     def progress(text: str) -> None:

@@ -8,9 +8,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from roadgaze.commands import common_options, config_from_args
-
-ORDER = 30
+from roadgaze.commands.options import common_options
+from roadgaze.config import Config
 
 
 def register(subparsers: Any) -> None:
@@ -31,11 +30,10 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.evaluation import estimate_images
-    from roadgaze.model_store import resolve_model
+    from roadgaze.landmarks.model_store import resolve_model
 
-    config = config_from_args(args)
     constants = config.geometry.face_constants()
     model_path = resolve_model(config.model)
     jobs = [(path, str(path)) for path in args.images]

@@ -7,9 +7,8 @@ import os
 from pathlib import Path
 from typing import Any
 
-from roadgaze.commands import common_options, config_from_args
-
-ORDER = 40
+from roadgaze.commands.options import common_options
+from roadgaze.config import Config
 
 
 def register(subparsers: Any) -> None:
@@ -54,7 +53,7 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     from dataclasses import replace
 
     from roadgaze.evaluation import (
@@ -70,9 +69,8 @@ def run(args: argparse.Namespace) -> int:
         write_report,
     )
     from roadgaze.landmarks import CANDIDATE_CHOICES
-    from roadgaze.model_store import resolve_model
+    from roadgaze.landmarks.model_store import resolve_model
 
-    config = config_from_args(args)
     truths, skipped = load_ground_truth(args.dataset)
     constants = config.geometry.face_constants()
     model_path = resolve_model(config.model)

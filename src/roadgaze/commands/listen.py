@@ -9,14 +9,11 @@ import sys
 import time
 from typing import Any
 
-from roadgaze.commands import common_options, config_from_args
-
-ORDER = 60
+from roadgaze.commands.options import add_zenoh_options, common_options, zenoh_config_from_args
+from roadgaze.config import Config
 
 
 def register(subparsers: Any) -> None:
-    from roadgaze.transport import add_zenoh_options
-
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "listen",
         parents=[common_options()],
@@ -93,12 +90,11 @@ def _decode(raw: bytes) -> tuple[dict[str, Any] | None, str]:
     return (value if isinstance(value, dict) else None), text
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     import zenoh
 
-    from roadgaze.transport import Keys, open_session, zenoh_config_from_args
+    from roadgaze.transport import Keys, open_session
 
-    config = config_from_args(args)
     zconf = zenoh_config_from_args(config.zenoh, args)
     keys = Keys.from_config(zconf, args.vehicle_id or "*")
     deadline = None if args.timeout is None else time.monotonic() + args.timeout

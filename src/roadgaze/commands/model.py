@@ -5,9 +5,8 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from roadgaze.commands import common_options, config_from_args
-
-ORDER = 20
+from roadgaze.commands.options import common_options
+from roadgaze.config import Config
 
 
 def register(subparsers: Any) -> None:
@@ -43,30 +42,30 @@ def register(subparsers: Any) -> None:
     verify.set_defaults(handler=run_verify)
 
 
-def run_fetch(args: argparse.Namespace) -> int:
-    from roadgaze.model_store import fetch_model
+def run_fetch(args: argparse.Namespace, config: Config) -> int:
+    from roadgaze.landmarks.model_store import fetch_model
 
-    print(fetch_model(config_from_args(args).model, force=args.force))
+    print(fetch_model(config.model, force=args.force))
     return 0
 
 
-def run_path(args: argparse.Namespace) -> int:
-    from roadgaze.model_store import resolve_model
+def run_path(args: argparse.Namespace, config: Config) -> int:
+    from roadgaze.landmarks.model_store import resolve_model
 
-    model = config_from_args(args).model.model_copy(update={"allow_download": False})
+    model = config.model.model_copy(update={"allow_download": False})
     print(resolve_model(model))
     return 0
 
 
-def run_verify(args: argparse.Namespace) -> int:
-    from roadgaze.model_store import (
+def run_verify(args: argparse.Namespace, config: Config) -> int:
+    from roadgaze.landmarks.model_store import (
         MODEL_FILENAME,
         check_file,
         default_cache_dir,
         explicit_model_path,
     )
 
-    model = config_from_args(args).model
+    model = config.model
     candidates = [("cache", default_cache_dir(model) / MODEL_FILENAME)]
     explicit = explicit_model_path(model)
     if explicit is not None:

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-ORDER = 10
+from roadgaze.config import Config
 
 
 def register(subparsers: Any) -> None:
@@ -20,8 +20,14 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    from roadgaze.paper import experiment_1, experiment_2, format_table, range_errors, save_plots
+def run(args: argparse.Namespace, config: Config) -> int:
+    from roadgaze.evaluation.paper import (
+        experiment_1,
+        experiment_2,
+        format_table,
+        range_errors,
+        save_plots,
+    )
 
     for stem, experiment in (("experiment1", experiment_1()), ("experiment2", experiment_2())):
         print(format_table(experiment, range_errors(experiment)))

@@ -1,10 +1,8 @@
 """`roadgaze replay VIDEO --out frames.jsonl`: run the pipeline over a recording, write per frame.
 
-Structure for extension: `add_arguments` declares the options, `build_sinks` turns them into
-pipeline sinks (in the order they see each sample), `run` opens source and detector, runs the
-loop and reports. A new output (a Zenoh publisher, a monitor) is one option in `add_arguments`
-and one sink in `build_sinks`; a monitor sink placed before the writers can add fields to every
-record through the writers' `extras`.
+`add_arguments` declares the options, `build_sinks` turns them into pipeline sinks, `run` opens
+source and detector, runs the loop and reports. Every sink reads the frame record, so a new
+output is one option and one sink, in any order.
 """
 
 from __future__ import annotations
@@ -16,16 +14,13 @@ from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from roadgaze.commands import common_options, config_from_args
+from roadgaze.commands.options import add_zenoh_options, common_options, with_zenoh_args
+from roadgaze.config import Config
+from roadgaze.types import Alert, Frame, FrameRecord
 
 if TYPE_CHECKING:
     from roadgaze.capture import SourceInfo
-    from roadgaze.config import Config
-    from roadgaze.outputs import Extras, StateText
     from roadgaze.pipeline import RunSummary, Sink
-    from roadgaze.types import YawSample
-
-ORDER = 30
 
 
 def register(subparsers: Any) -> None:
@@ -33,9 +28,9 @@ def register(subparsers: Any) -> None:
         "replay",
         parents=[common_options()],
         help="run the yaw pipeline over a video and write one record per frame",
-        description="Run capture -> landmarks -> Center-CE yaw -> Kalman smoother over a video "
-        "file (or image folder, or camera) and write one JSON object per frame. A progress bar "
-        "with fps and ETA goes to stderr.",
+        description="Run capture -> landmarks -> Center-CE yaw -> Kalman smoother -> monitor "
+        "over a video file (or image folder, or camera) and write one JSON object per frame. A "
+        "progress bar with fps and ETA goes to stderr.",
     )
     add_arguments(parser)
     parser.set_defaults(handler=run)
@@ -65,16 +60,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
-    add_monitor_arguments(parser)
-
-
-# --- Monitor and Zenoh publishing (roadgaze.monitor / roadgaze.daemon) -------------------------
-
-
-def add_monitor_arguments(parser: argparse.ArgumentParser) -> None:
-    """--publish and the Zenoh options; the monitor itself always runs and fills the records."""
-    from roadgaze.transport import add_zenoh_options
-
     parser.add_argument(
         "--publish",
         action="store_true",
@@ -83,27 +68,8 @@ def add_monitor_arguments(parser: argparse.ArgumentParser) -> None:
     add_zenoh_options(parser)
 
 
-def monitor_config(args: argparse.Namespace, config: Config) -> Config:
-    from roadgaze.transport import zenoh_config_from_args
-
-    return config.model_copy(update={"zenoh": zenoh_config_from_args(config.zenoh, args)})
-
-
-def report_alerts(args: argparse.Namespace, alerts: list[Any]) -> None:
-    for alert in alerts:
-        print(
-            f"replay {args.source}: alert {alert.kind.value} {alert.level.value} "
-            f"at t={alert.t_s:.2f}s (off road {alert.off_road_s:.2f}s, "
-            f"window {alert.window_off_road_s:.2f}s)",
-            file=sys.stderr,
-        )
-
-
-# --- end of monitor and Zenoh publishing -------------------------------------------------------
-
-
 class ReplayStats:
-    """Counts faces and the range of raw and smoothed yaw, for the closing summary line."""
+    """Counts faces, the range of raw and smoothed yaw and the alerts, for the closing summary."""
 
     def __init__(self) -> None:
         self.frames = 0
@@ -112,8 +78,10 @@ class ReplayStats:
         self.raw_max_deg = -math.inf
         self.smoothed_min_deg = math.inf
         self.smoothed_max_deg = -math.inf
+        self.alerts: list[Alert] = []
 
-    def on_sample(self, sample: YawSample) -> None:
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        sample = record.sample
         self.frames += 1
         self.faces += sample.face
         if sample.yaw_raw_deg is not None:
@@ -122,6 +90,7 @@ class ReplayStats:
         if sample.yaw_deg is not None:
             self.smoothed_min_deg = min(self.smoothed_min_deg, sample.yaw_deg)
             self.smoothed_max_deg = max(self.smoothed_max_deg, sample.yaw_deg)
+        self.alerts.extend(record.alerts)
 
     def close(self) -> None:
         return None
@@ -136,39 +105,20 @@ class ReplayStats:
         return text
 
 
-def record_extras(args: argparse.Namespace, config: Config) -> list[Extras]:
-    """Extra per-frame fields for the JSONL/CSV records (none yet; e.g. a monitor's state)."""
-    return []
-
-
-def build_sinks(
-    args: argparse.Namespace,
-    config: Config,
-    info: SourceInfo,
-    stack: ExitStack,
-    extras: list[Extras] | None = None,
-    state_text: StateText | None = None,
-) -> list[Sink]:
-    """The sinks the options ask for, each registered on `stack` so it is closed at the end.
-
-    `state_text` adds a line per frame to the annotated video (the monitor's state).
-    """
+def build_sinks(args: argparse.Namespace, info: SourceInfo, stack: ExitStack) -> list[Sink]:
+    """The writer sinks the options ask for, each registered on `stack` to be closed at the end."""
     from roadgaze.outputs import AnnotatedVideoWriter, CsvWriter, JsonlWriter, ProgressBar, YawPlot
 
-    extras = extras if extras is not None else record_extras(args, config)
     sinks: list[Sink] = []
-    # A sink that adds record fields (e.g. a monitor) goes here, first, and appends its
-    # field function to `extras`, so the writers below see its verdict on the same sample.
     if args.out is not None:
         target = sys.stdout if args.out == "-" else Path(args.out)
-        sinks.append(stack.enter_context(JsonlWriter(target, extras)))
+        sinks.append(stack.enter_context(JsonlWriter(target)))
     if args.csv is not None:
-        sinks.append(stack.enter_context(CsvWriter(args.csv, extras)))
+        sinks.append(stack.enter_context(CsvWriter(args.csv)))
     if args.plot is not None:
         sinks.append(stack.enter_context(YawPlot(args.plot, title=Path(info.name).name)))
     if args.annotate is not None:
-        writer = AnnotatedVideoWriter(args.annotate, info.fps or 30.0, state_text)
-        sinks.append(stack.enter_context(writer))
+        sinks.append(stack.enter_context(AnnotatedVideoWriter(args.annotate, info.fps or 30.0)))
     if not args.no_progress:
         total = info.frame_count
         if args.max_frames is not None and total is not None:
@@ -191,32 +141,34 @@ def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) ->
         value = getattr(args, name)
         if value is not None and value != "-":
             print(f"wrote {value}", file=sys.stderr)
+    for alert in stats.alerts:
+        print(
+            f"replay {args.source}: alert {alert.kind.value} {alert.level.value} "
+            f"at t={alert.t_s:.2f}s (off road {alert.off_road_s:.2f}s, "
+            f"window {alert.window_off_road_s:.2f}s)",
+            file=sys.stderr,
+        )
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.capture import open_source
-    from roadgaze.daemon import publishing_sink
+    from roadgaze.daemon import bus_outputs
     from roadgaze.errors import ConfigError
-    from roadgaze.pipeline import Pipeline, create_detector, sigterm_as_interrupt
+    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.signals import sigterm_as_interrupt
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
-    config = monitor_config(args, config_from_args(args))
+    config = with_zenoh_args(config, args)
     stats = ReplayStats()
     with ExitStack() as stack:
         stack.enter_context(sigterm_as_interrupt())
         source = stack.enter_context(open_source(args.source, config))
         detector = create_detector(config)
         stack.callback(detector.close)
-        monitor = stack.enter_context(publishing_sink(config, args.source, args.publish))
-        extras = [*record_extras(args, config), monitor.extras]
-        sinks: list[Sink] = [
-            stats,
-            monitor,
-            *build_sinks(args, config, source.info, stack, extras, monitor.state_text),
-        ]
-        pipeline = Pipeline.from_config(config, detector)
+        bus = stack.enter_context(bus_outputs(config, args.source, args.publish))
+        sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack)]
+        pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
     report(args, summary, stats)
-    report_alerts(args, monitor.alerts)
     return 0

@@ -5,14 +5,11 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from roadgaze.commands import common_options, config_from_args
-
-ORDER = 50
+from roadgaze.commands.options import add_zenoh_options, common_options, with_zenoh_args
+from roadgaze.config import Config
 
 
 def register(subparsers: Any) -> None:
-    from roadgaze.transport import add_zenoh_options
-
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "run",
         parents=[common_options()],
@@ -35,13 +32,7 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.daemon import run_daemon
-    from roadgaze.logs import setup_logging
-    from roadgaze.transport import zenoh_config_from_args
 
-    config = config_from_args(args)
-    config = config.model_copy(update={"zenoh": zenoh_config_from_args(config.zenoh, args)})
-    if args.log_level is None and not args.log_json:
-        setup_logging(config.logging.level, config.logging.json_format)
-    return run_daemon(config, args.source, realtime=not args.no_realtime)
+    return run_daemon(with_zenoh_args(config, args), args.source, realtime=not args.no_realtime)

@@ -6,7 +6,8 @@ import argparse
 import json
 from typing import Any
 
-ORDER = 80
+from roadgaze.config import Config
+
 NAMES = ("yaw", "alert", "state")
 
 
@@ -22,7 +23,7 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.transport import json_schemas
 
     schemas = json_schemas()

@@ -7,10 +7,10 @@ import re
 from pathlib import Path
 from typing import Any
 
-from roadgaze.commands import common_options, config_from_args
+from roadgaze.commands.options import common_options
+from roadgaze.config import Config
 from roadgaze.errors import ConfigError
 
-ORDER = 60
 EXAMPLE_TIMELINE = "0:2,40:3.5,0:2,-35:1,0:2"
 
 
@@ -80,10 +80,9 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.synth import load_photo, parse_timeline, render_clip, truth_path_for
 
-    config = config_from_args(args)
     size = parse_size(args.size)
     if args.measure:
         from roadgaze.synth import format_measurement, measure_yaw_recovery, write_measurement_csv

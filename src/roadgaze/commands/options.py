@@ -1,0 +1,81 @@
+"""Command-line flags shared by several commands: configuration, logging and Zenoh."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from roadgaze.config import Config, ZenohConfig, load_config, parse_overrides
+from roadgaze.errors import ConfigError
+
+
+def common_options() -> argparse.ArgumentParser:
+    """--config, --set, --log-level and --log-json, for use as `parents=[common_options()]`."""
+    parent = argparse.ArgumentParser(add_help=False)
+    group = parent.add_argument_group("configuration")
+    group.add_argument("--config", type=Path, metavar="FILE", help="TOML configuration file")
+    group.add_argument(
+        "--set",
+        action="append",
+        metavar="SECTION.FIELD=VALUE",
+        help="override one configuration value (repeatable), e.g. --set monitor.min_speed_kmh=30",
+    )
+    group.add_argument(
+        "--log-level", choices=["DEBUG", "INFO", "WARNING", "ERROR"], help="log level"
+    )
+    group.add_argument("--log-json", action="store_true", help="log one JSON object per line")
+    return parent
+
+
+def config_from_args(args: argparse.Namespace) -> Config:
+    """The configuration named by the common options (file, environment, --set); the defaults
+    (and the environment) for a command without them."""
+    return load_config(getattr(args, "config", None), parse_overrides(getattr(args, "set", None)))
+
+
+def add_zenoh_options(parser: Any) -> None:
+    """Command-line options shared by run, replay --publish and listen."""
+    group = parser.add_argument_group("zenoh")
+    group.add_argument("--vehicle-id", metavar="ID", help="vehicle id in the key expressions")
+    group.add_argument(
+        "--zenoh-connect",
+        action="append",
+        metavar="ENDPOINT",
+        help="endpoint to connect to, e.g. tcp/127.0.0.1:7447 (repeatable)",
+    )
+    group.add_argument(
+        "--zenoh-listen",
+        action="append",
+        metavar="ENDPOINT",
+        help="endpoint to listen on (repeatable; default tcp/127.0.0.1:0)",
+    )
+    group.add_argument("--zenoh-mode", choices=["peer", "client"], help="zenoh session mode")
+
+
+def zenoh_config_from_args(config: ZenohConfig, args: Any) -> ZenohConfig:
+    """`config` with the --vehicle-id/--zenoh-* options applied (validated again)."""
+    update: dict[str, Any] = {}
+    if getattr(args, "vehicle_id", None) and args.vehicle_id != "*":
+        update["vehicle_id"] = args.vehicle_id
+    if getattr(args, "zenoh_connect", None):
+        update["connect"] = list(args.zenoh_connect)
+    if getattr(args, "zenoh_listen", None):
+        update["listen"] = list(args.zenoh_listen)
+    if getattr(args, "zenoh_mode", None):
+        update["mode"] = args.zenoh_mode
+    if not update:
+        return config
+    merged = {name: getattr(config, name) for name in config.model_fields_set} | update
+    try:
+        return ZenohConfig.model_validate(merged)
+    except ValidationError as exc:
+        problems = "; ".join(f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors())
+        raise ConfigError(f"bad zenoh option: {problems}") from None
+
+
+def with_zenoh_args(config: Config, args: Any) -> Config:
+    """`config` with its `[zenoh]` section updated by the --vehicle-id/--zenoh-* options."""
+    return config.model_copy(update={"zenoh": zenoh_config_from_args(config.zenoh, args)})

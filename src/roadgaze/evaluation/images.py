@@ -1,0 +1,227 @@
+"""Yaw on still images: the landmark stage and all five yaw models per file, in worker processes.
+
+`estimate_images` yields one `ImageEstimate` per file, in order; a file that cannot be read gives
+an estimate with `error` set, and the others still run.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from roadgaze.config import LandmarksConfig
+from roadgaze.errors import SourceError
+from roadgaze.pose.geometry import PAPER_CONSTANTS, YAW_MODELS, FaceModelConstants
+from roadgaze.types import Detection, LandmarkDetector
+
+MODEL_NAMES: tuple[str, ...] = tuple(YAW_MODELS)
+"""The paper's five models, in the paper's order."""
+
+
+@dataclass(frozen=True, slots=True)
+class ImageEstimate:
+    """The driver's yaw in one image by every model, or why there is none.
+
+    `face` is False when no face was found or the file could not be used (`error` then says
+    why). Yaw values are degrees in the project convention; None where a model cannot explain
+    the measured geometry.
+    """
+
+    file: str
+    face: bool
+    n_faces: int = 0
+    yaw_deg_by_model: Mapping[str, float | None] = field(default_factory=dict)
+    mediapipe_yaw_deg: float | None = None
+    mediapipe_pitch_deg: float | None = None
+    x_left_px: float | None = None
+    x_right_px: float | None = None
+    x_center_px: float | None = None
+    roll_deg: float | None = None
+    quality: float | None = None
+    error: str | None = None
+    landmarks_px: npt.NDArray[np.float32] | None = None
+    """The driver's (478, 3) landmarks, kept for re-scoring other landmark choices."""
+
+    @property
+    def yaw_deg(self) -> float | None:
+        """Center-CE, the paper's best model."""
+        return self.yaw_deg_by_model.get("center_ce")
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The fields `roadgaze estimate` prints (no landmarks)."""
+        result: dict[str, Any] = {
+            "file": self.file,
+            "face": self.face,
+            "n_faces": self.n_faces,
+            "yaw_deg": self.yaw_deg,
+            "models": {name: self.yaw_deg_by_model.get(name) for name in MODEL_NAMES},
+            "mediapipe_yaw_deg": self.mediapipe_yaw_deg,
+            "mediapipe_pitch_deg": self.mediapipe_pitch_deg,
+            "x_left": self.x_left_px,
+            "x_right": self.x_right_px,
+            "x_center": self.x_center_px,
+            "roll_deg": self.roll_deg,
+            "quality": self.quality,
+        }
+        if self.error is not None:
+            result["error"] = self.error
+        return result
+
+
+def _finite_or_none(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def yaw_by_model(
+    x_left_px: float,
+    x_right_px: float,
+    x_center_px: float,
+    constants: FaceModelConstants = PAPER_CONSTANTS,
+) -> dict[str, float | None]:
+    """Every model's yaw in degrees (None where the model cannot explain the geometry)."""
+    return {
+        name: _finite_or_none(float(model(x_left_px, x_right_px, x_center_px, constants)))
+        for name, model in YAW_MODELS.items()
+    }
+
+
+def read_image(path: Path) -> npt.NDArray[np.uint8]:
+    """An image file as uint8 grayscale or BGR, EXIF orientation applied; SourceError if unusable.
+
+    16-bit images are scaled to 8 bits; an alpha channel is dropped.
+    """
+    import cv2
+
+    if not path.exists():
+        raise SourceError(f"{path}: file not found")
+    if not path.is_file():
+        raise SourceError(f"{path}: not a regular file")
+    # ANYCOLOR | ANYDEPTH keeps grayscale and 16-bit data and applies the EXIF orientation
+    # (IMREAD_UNCHANGED would ignore it and hand MediaPipe a sideways phone photo).
+    decoded = cv2.imread(str(path), cv2.IMREAD_ANYCOLOR | cv2.IMREAD_ANYDEPTH)
+    if decoded is None or decoded.size == 0:
+        raise SourceError(f"{path}: cannot decode as an image (corrupt or unsupported format)")
+    image: npt.NDArray[Any] = np.asarray(decoded)
+    if image.dtype == np.uint16:
+        image = (image // 256).astype(np.uint8)
+    elif image.dtype != np.uint8:
+        low, high = float(np.nanmin(image)), float(np.nanmax(image))
+        image = (255.0 * (image - low) / max(high - low, 1e-12)).astype(np.uint8)
+    if image.ndim == 3 and image.shape[2] not in (1, 3, 4):
+        raise SourceError(f"{path}: unsupported image with {image.shape[2]} channels")
+    return np.asarray(image, dtype=np.uint8)
+
+
+def estimate_from_detection(
+    name: str, detection: Detection, constants: FaceModelConstants = PAPER_CONSTANTS
+) -> ImageEstimate:
+    """The driver's estimate from one detection result."""
+    driver = detection.driver
+    if driver is None:
+        return ImageEstimate(file=name, face=False, n_faces=len(detection.faces))
+    return ImageEstimate(
+        file=name,
+        face=True,
+        n_faces=len(detection.faces),
+        yaw_deg_by_model=yaw_by_model(
+            driver.x_left_px, driver.x_right_px, driver.x_center_px, constants
+        ),
+        mediapipe_yaw_deg=driver.mediapipe_yaw_deg,
+        mediapipe_pitch_deg=driver.mediapipe_pitch_deg,
+        x_left_px=driver.x_left_px,
+        x_right_px=driver.x_right_px,
+        x_center_px=driver.x_center_px,
+        roll_deg=driver.roll_deg,
+        quality=driver.quality,
+        landmarks_px=driver.landmarks_px,
+    )
+
+
+def estimate_image(
+    detector: LandmarkDetector,
+    path: Path,
+    constants: FaceModelConstants = PAPER_CONSTANTS,
+    name: str | None = None,
+) -> ImageEstimate:
+    """Run the landmark stage and the yaw models on one file; errors become `error`, not raise."""
+    label = str(path) if name is None else name
+    try:
+        image = read_image(path)
+        detection = detector.detect(image)
+    except (SourceError, ValueError) as exc:
+        return ImageEstimate(file=label, face=False, error=str(exc))
+    return estimate_from_detection(label, detection, constants)
+
+
+_worker: dict[str, Any] = {}
+
+
+def _close_worker() -> None:
+    detector = _worker.pop("detector", None)
+    if detector is not None:
+        detector.close()
+
+
+def _init_worker(
+    landmarks_config: LandmarksConfig, model_path: Path, constants: FaceModelConstants
+) -> None:
+    from multiprocessing.util import Finalize
+
+    from roadgaze.landmarks.landmarker import MediaPipeLandmarker
+
+    _worker["detector"] = MediaPipeLandmarker(landmarks_config, model_path, video=False)
+    _worker["constants"] = constants
+    # Runs when the worker leaves its loop, while MediaPipe's threads are still alive (an atexit
+    # hook would run after they are gone and fail).
+    Finalize(None, _close_worker, exitpriority=10)
+
+
+def _worker_estimate(job: tuple[Path, str]) -> ImageEstimate:
+    path, name = job
+    return estimate_image(_worker["detector"], path, _worker["constants"], name)
+
+
+def estimate_images(
+    jobs: Sequence[tuple[Path, str]],
+    landmarks_config: LandmarksConfig,
+    model_path: Path,
+    constants: FaceModelConstants = PAPER_CONSTANTS,
+    workers: int = 1,
+    progress: bool = False,
+    description: str = "images",
+) -> Iterator[ImageEstimate]:
+    """One `ImageEstimate` per (path, display name), in input order.
+
+    `workers` > 1 uses that many processes (spawned, each with its own landmarker); the progress
+    bar, when asked for, goes to stderr.
+    """
+    from tqdm import tqdm
+
+    bar = tqdm(total=len(jobs), desc=description, unit="img", disable=not progress, leave=False)
+    try:
+        if workers <= 1 or len(jobs) <= 1:
+            from roadgaze.landmarks.landmarker import MediaPipeLandmarker
+
+            with MediaPipeLandmarker(landmarks_config, model_path, video=False) as detector:
+                for path, name in jobs:
+                    yield estimate_image(detector, path, constants, name)
+                    bar.update(1)
+            return
+        context = multiprocessing.get_context("spawn")
+        with context.Pool(
+            processes=workers,
+            initializer=_init_worker,
+            initargs=(landmarks_config, model_path, constants),
+        ) as pool:
+            for estimate in pool.imap(_worker_estimate, jobs, chunksize=8):
+                yield estimate
+                bar.update(1)
+    finally:
+        bar.close()

@@ -1,0 +1,126 @@
+"""Which face is the driver, and averaging a face with its measurement in the mirrored image."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from roadgaze.types import FaceFeatures
+
+DRIVER_SWITCH_AREA_RATIO = 1.25
+"""In a stream, the "largest" rule moves to another face only when that face's box is this much
+larger than the current driver's; faces of similar size would otherwise swap from frame to frame."""
+DRIVER_MATCH_IOU = 0.3
+"""Box overlap above which a face in a new frame is taken to be the previous frame's driver."""
+
+
+def _area(face: FaceFeatures) -> float:
+    return (face.box_px[2] - face.box_px[0]) * (face.box_px[3] - face.box_px[1])
+
+
+def choose_driver(
+    faces: Sequence[FaceFeatures],
+    rule: str,
+    previous_box_px: tuple[float, float, float, float] | None = None,
+) -> int | None:
+    """Index of the driver among `faces` under `rule`, None when there is no face.
+
+    "largest": the face with the largest bounding-box area (default; the driver sits nearest the
+    camera). "left" / "right": the face whose box centre is furthest to the image's left / right,
+    i.e. the driver sits on that side of the picture as the camera sees it (for a camera facing a
+    left-hand-drive driver from the dashboard centre, the driver appears on the image's right).
+    `previous_box_px` (streams): the previous frame's driver box; under "largest" that face stays
+    the driver unless another is `DRIVER_SWITCH_AREA_RATIO` times larger.
+    """
+    if not faces:
+        return None
+    if rule == "largest":
+        areas = [_area(f) for f in faces]
+        best = int(np.argmax(areas))
+        if previous_box_px is not None:
+            overlaps = [box_iou(f.box_px, previous_box_px) for f in faces]
+            kept = int(np.argmax(overlaps))
+            if (
+                overlaps[kept] >= DRIVER_MATCH_IOU
+                and areas[best] < DRIVER_SWITCH_AREA_RATIO * areas[kept]
+            ):
+                return kept
+        return best
+    centers = [0.5 * (f.box_px[0] + f.box_px[2]) for f in faces]
+    if rule == "left":
+        return int(np.argmin(centers))
+    if rule == "right":
+        return int(np.argmax(centers))
+    raise ValueError(f"unknown driver rule '{rule}'; choose largest, left or right")
+
+
+def box_iou(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> float:
+    width = min(a[2], b[2]) - max(a[0], b[0])
+    height = min(a[3], b[3]) - max(a[1], b[1])
+    if width <= 0 or height <= 0:
+        return 0.0
+    inter = width * height
+    area_a = (a[2] - a[0]) * (a[3] - a[1])
+    area_b = (b[2] - b[0]) * (b[3] - b[1])
+    return inter / (area_a + area_b - inter)
+
+
+def unmirror(face: FaceFeatures, image_width_px: int) -> FaceFeatures:
+    """A face measured in the horizontally flipped image, expressed in the original image.
+
+    x becomes width - x (so left and right boundaries swap), roll and yaw change sign. The
+    landmark array is flipped in x but keeps MediaPipe's indices of the flipped face.
+    """
+    width = float(image_width_px)
+    points = face.landmarks_px.copy()
+    points[:, 0] = width - points[:, 0]
+    x_min, y_min, x_max, y_max = face.box_px
+    return FaceFeatures(
+        x_left_px=width - face.x_right_px,
+        x_right_px=width - face.x_left_px,
+        x_center_px=width - face.x_center_px,
+        roll_deg=-face.roll_deg,
+        box_px=(width - x_max, y_min, width - x_min, y_max),
+        quality=face.quality,
+        landmarks_px=points,
+        mediapipe_yaw_deg=None if face.mediapipe_yaw_deg is None else -face.mediapipe_yaw_deg,
+        mediapipe_pitch_deg=face.mediapipe_pitch_deg,
+    )
+
+
+def _mean(a: float | None, b: float | None) -> float | None:
+    return None if a is None or b is None else 0.5 * (a + b)
+
+
+def merge_mirrored(
+    faces: Sequence[FaceFeatures], mirrored_faces: Sequence[FaceFeatures], image_width_px: int
+) -> list[FaceFeatures]:
+    """Average each face with its measurement in the flipped image (matched by box overlap).
+
+    The result is exactly mirror-symmetric: flipping the input negates every yaw. A face found in
+    only one of the two images is kept as found there.
+    """
+    candidates = [unmirror(face, image_width_px) for face in mirrored_faces]
+    merged: list[FaceFeatures] = []
+    for face in faces:
+        overlaps = [box_iou(face.box_px, other.box_px) for other in candidates]
+        best = int(np.argmax(overlaps)) if overlaps else -1
+        if best < 0 or overlaps[best] < 0.3:
+            merged.append(face)
+            continue
+        other = candidates.pop(best)
+        merged.append(
+            FaceFeatures(
+                x_left_px=0.5 * (face.x_left_px + other.x_left_px),
+                x_right_px=0.5 * (face.x_right_px + other.x_right_px),
+                x_center_px=0.5 * (face.x_center_px + other.x_center_px),
+                roll_deg=0.5 * (face.roll_deg + other.roll_deg),
+                box_px=tuple(0.5 * (p + q) for p, q in zip(face.box_px, other.box_px, strict=True)),  # type: ignore[arg-type]
+                quality=0.5 * (face.quality + other.quality),
+                landmarks_px=face.landmarks_px,
+                mediapipe_yaw_deg=_mean(face.mediapipe_yaw_deg, other.mediapipe_yaw_deg),
+                mediapipe_pitch_deg=_mean(face.mediapipe_pitch_deg, other.mediapipe_pitch_deg),
+            )
+        )
+    return merged + candidates

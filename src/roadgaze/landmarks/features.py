@@ -1,0 +1,194 @@
+"""Face features from MediaPipe's 478 landmarks (pure numpy): boundaries and centre, roll removed.
+
+`features_from_landmarks` turns one face's landmarks into the three inputs of the yaw models
+(Narayanan et al. 2014): the eye line (outer corners 33 and 263) gives the roll; the landmarks
+are rotated about the eye midpoint so that the eye line is horizontal; then
+
+- the left and right boundaries are the extreme x of all mesh landmarks (the silhouette of the
+  projected mesh) in a horizontal band from 0.1 to 0.5 of the eye-to-mouth distance below the eye
+  line (cheek height, below the eyes and above the mouth), and
+- the centre is the mean x of the nose tip (1) and the point just above it on the ridge (4),
+
+a choice measured on Pointing'04 subjects 1-10 against the alternatives (docs/landmarks.md).
+
+Sign conventions: image x grows right, y down. `roll_deg` > 0 is a counter-clockwise head tilt as
+seen in the image. Yaw > 0 is the head turned to the person's own left (ISO 8855), which an
+unmirrored camera sees as the nose pointing to the image right.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from roadgaze.types import FaceFeatures
+
+NUM_LANDMARKS = 478
+RIGHT_EYE_OUTER = 33
+"""The person's right eye, outer corner (image left for an unmirrored camera)."""
+LEFT_EYE_OUTER = 263
+"""The person's left eye, outer corner (image right for an unmirrored camera)."""
+NOSE_TIP = 1
+MOUTH_CORNERS = (61, 291)
+
+FACE_OVAL = (
+    10, 338, 297, 332, 284, 251, 389, 356, 454, 323, 361, 288, 397, 365, 379, 378, 400, 377,
+    152, 148, 176, 149, 150, 136, 172, 58, 132, 93, 234, 127, 162, 21, 54, 103, 67, 109,
+)  # fmt: skip
+"""MediaPipe's face-oval landmarks (FaceLandmarksConnections.FACE_LANDMARKS_FACE_OVAL)."""
+
+
+@dataclass(frozen=True, slots=True)
+class LandmarkChoice:
+    """Which landmarks give the face boundaries and the centre.
+
+    Boundaries: the extreme (min and max) roll-removed x of `boundary_landmarks` (None: all 478
+    landmarks, i.e. the silhouette of the projected mesh), keeping only those whose roll-removed
+    height lies in `boundary_band`, measured in units of the eye-to-mouth distance below the eye
+    line (0 = eye height, 1 = mouth-corner height; None = no height limit).
+    Centre: the mean roll-removed x of `center_landmarks`.
+    """
+
+    name: str
+    center_landmarks: tuple[int, ...]
+    boundary_landmarks: tuple[int, ...] | None = None
+    boundary_band: tuple[float, float] | None = None
+
+
+DEFAULT_CHOICE = LandmarkChoice(
+    name="mesh silhouette in band [0.1, 0.5] / nose 1+4",
+    center_landmarks=(NOSE_TIP, 4),
+    boundary_landmarks=None,
+    boundary_band=(0.1, 0.5),
+)
+"""The measured best choice on Pointing'04 subjects 1-10 together (docs/landmarks.md)."""
+
+
+def roll_from_eyes_deg(landmarks_px: npt.NDArray[np.floating[Any]]) -> float:
+    """Counter-clockwise (as seen in the image) angle of the eye line 33 -> 263, degrees."""
+    dx = float(landmarks_px[LEFT_EYE_OUTER, 0] - landmarks_px[RIGHT_EYE_OUTER, 0])
+    dy = float(landmarks_px[LEFT_EYE_OUTER, 1] - landmarks_px[RIGHT_EYE_OUTER, 1])
+    return math.degrees(math.atan2(-dy, dx))
+
+
+def remove_roll(
+    landmarks_px: npt.NDArray[np.floating[Any]], roll_deg: float
+) -> npt.NDArray[np.float64]:
+    """(N, 2) x, y rotated about the eye midpoint so that the eye line becomes horizontal."""
+    points = np.asarray(landmarks_px[:, :2], dtype=np.float64)
+    pivot = 0.5 * (points[RIGHT_EYE_OUTER] + points[LEFT_EYE_OUTER])
+    # In y-down image coordinates a counter-clockwise (on screen) roll of r is undone by the
+    # matrix [[cos r, -sin r], [sin r, cos r]] applied to (x, y).
+    angle = math.radians(roll_deg)
+    cos_a, sin_a = math.cos(angle), math.sin(angle)
+    rotation = np.array([[cos_a, -sin_a], [sin_a, cos_a]])
+    return np.asarray((points - pivot) @ rotation.T + pivot, dtype=np.float64)
+
+
+def boundaries_and_center(
+    upright_px: npt.NDArray[np.float64], choice: LandmarkChoice = DEFAULT_CHOICE
+) -> tuple[float, float, float]:
+    """x_left, x_right, x_center from roll-removed (N, 2) landmarks under `choice`.
+
+    When fewer than two landmarks fall in the height band (a degenerate face), the band is
+    ignored rather than failing.
+    """
+    x_center = float(np.mean(upright_px[list(choice.center_landmarks), 0]))
+    candidates = (
+        upright_px
+        if choice.boundary_landmarks is None
+        else upright_px[list(choice.boundary_landmarks)]
+    )
+    if choice.boundary_band is not None:
+        eye_y = 0.5 * (upright_px[RIGHT_EYE_OUTER, 1] + upright_px[LEFT_EYE_OUTER, 1])
+        mouth_y = 0.5 * (upright_px[MOUTH_CORNERS[0], 1] + upright_px[MOUTH_CORNERS[1], 1])
+        span = mouth_y - eye_y
+        if span > 0:
+            low, high = choice.boundary_band
+            level = (candidates[:, 1] - eye_y) / span
+            in_band = (level >= low) & (level <= high)
+            if np.count_nonzero(in_band) >= 2:
+                candidates = candidates[in_band]
+    return float(candidates[:, 0].min()), float(candidates[:, 0].max()), x_center
+
+
+def angles_from_matrix_deg(matrix: npt.ArrayLike) -> tuple[float, float]:
+    """Yaw and pitch (degrees, project convention) from MediaPipe's facial transformation matrix.
+
+    The matrix maps MediaPipe's canonical face model into camera space; its third column is the
+    face's forward (nose) direction in the camera frame, from which yaw (about the vertical axis)
+    and pitch (about the horizontal one) follow. Signs verified on Pointing'04 subjects 1-10
+    (docs/landmarks.md): a nose pointing to the image right gives yaw > 0, a face looking up
+    gives pitch > 0.
+    """
+    rotation = np.asarray(matrix, dtype=np.float64)[:3, :3]
+    yaw_deg = math.degrees(math.atan2(float(rotation[0, 2]), float(rotation[2, 2])))
+    pitch_deg = math.degrees(
+        math.atan2(float(rotation[1, 2]), math.hypot(float(rotation[0, 2]), float(rotation[2, 2])))
+    )
+    return yaw_deg, pitch_deg
+
+
+def face_quality(
+    landmarks_px: npt.NDArray[np.floating[Any]],
+    box_px: tuple[float, float, float, float],
+    image_size_px: tuple[int, int] | None,
+) -> float:
+    """0..1: face width relative to 80 px, times the fraction of landmarks inside the image."""
+    width_px = box_px[2] - box_px[0]
+    size_score = min(1.0, max(0.0, width_px / 80.0))
+    if image_size_px is None:
+        return size_score
+    width, height = image_size_px
+    xy = landmarks_px[:, :2]
+    inside = (xy[:, 0] >= 0) & (xy[:, 0] < width) & (xy[:, 1] >= 0) & (xy[:, 1] < height)
+    return size_score * float(np.mean(inside))
+
+
+def features_from_landmarks(
+    landmarks_px: npt.ArrayLike,
+    image_size_px: tuple[int, int] | None = None,
+    transformation_matrix: npt.ArrayLike | None = None,
+    choice: LandmarkChoice = DEFAULT_CHOICE,
+) -> FaceFeatures:
+    """The yaw models' inputs for one face from its (478, 3) landmarks in pixels (numpy only).
+
+    `image_size_px` (width, height) enables the edge term of `quality`; `transformation_matrix`
+    (MediaPipe's 4x4) fills `mediapipe_yaw_deg` / `mediapipe_pitch_deg`. Raises ValueError for a
+    wrong shape or non-finite landmarks.
+    """
+    points = np.asarray(landmarks_px, dtype=np.float32)
+    if points.ndim != 2 or points.shape[0] != NUM_LANDMARKS or points.shape[1] not in (2, 3):
+        raise ValueError(f"expected ({NUM_LANDMARKS}, 3) landmarks, found shape {points.shape}")
+    if points.shape[1] == 2:
+        points = np.concatenate([points, np.zeros((NUM_LANDMARKS, 1), np.float32)], axis=1)
+    if not np.all(np.isfinite(points)):
+        raise ValueError("landmarks contain NaN or infinite values")
+    roll_deg = roll_from_eyes_deg(points)
+    upright = remove_roll(points, roll_deg)
+    x_left, x_right, x_center = boundaries_and_center(upright, choice)
+    box = (
+        float(points[:, 0].min()),
+        float(points[:, 1].min()),
+        float(points[:, 0].max()),
+        float(points[:, 1].max()),
+    )
+    yaw_mp: float | None = None
+    pitch_mp: float | None = None
+    if transformation_matrix is not None:
+        yaw_mp, pitch_mp = angles_from_matrix_deg(transformation_matrix)
+    return FaceFeatures(
+        x_left_px=x_left,
+        x_right_px=x_right,
+        x_center_px=x_center,
+        roll_deg=roll_deg,
+        box_px=box,
+        quality=face_quality(points, box, image_size_px),
+        landmarks_px=points,
+        mediapipe_yaw_deg=yaw_mp,
+        mediapipe_pitch_deg=pitch_mp,
+    )

@@ -1,0 +1,139 @@
+"""The flat per-frame record (one definition) and the writers of it: JSON lines and CSV.
+
+`record_fields(record)` flattens a `FrameRecord` into the JSON-ready dict every writer uses:
+the pose sample's fields, then the monitor's verdict and the alerts raised on that frame.
+Every writer is a context manager and a pipeline sink (`on_record`, `close`).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+from typing import IO, Any
+
+from roadgaze.errors import RoadgazeError
+from roadgaze.types import ClosesOnExit, Frame, FrameRecord
+
+RECORD_FIELDS = (
+    "t_s",
+    "frame",
+    "face",
+    "n_faces",
+    "yaw_raw_deg",
+    "yaw_deg",
+    "yaw_rate_dps",
+    "yaw_std_deg",
+    "x_left",
+    "x_right",
+    "x_center",
+    "roll_deg",
+    "quality",
+    "on_road",
+    "gaze",
+    "neutral_yaw_deg",
+    "off_road_s",
+    "window_off_road_s",
+    "alerts",
+)
+"""The fields of `record_fields`, in order (x_* in pixels of the roll-removed frame)."""
+
+
+def rounded(value: float | None, digits: int) -> float | None:
+    """`value` rounded for a record; None for None, NaN or infinity."""
+    if value is None or not math.isfinite(value):
+        return None
+    return round(float(value), digits)
+
+
+def record_fields(record: FrameRecord) -> dict[str, Any]:
+    """The per-frame record as a JSON-ready dict; None (null) where there is no value."""
+    sample, verdict = record.sample, record.verdict
+    features = sample.features
+    return {
+        "t_s": round(sample.t_s, 6),
+        "frame": sample.frame,
+        "face": sample.face,
+        "n_faces": sample.n_faces,
+        "yaw_raw_deg": rounded(sample.yaw_raw_deg, 3),
+        "yaw_deg": rounded(sample.yaw_deg, 3),
+        "yaw_rate_dps": rounded(sample.yaw_rate_dps, 3),
+        "yaw_std_deg": rounded(sample.yaw_std_deg, 3),
+        "x_left": None if features is None else rounded(features.x_left_px, 2),
+        "x_right": None if features is None else rounded(features.x_right_px, 2),
+        "x_center": None if features is None else rounded(features.x_center_px, 2),
+        "roll_deg": None if features is None else rounded(features.roll_deg, 2),
+        "quality": None if features is None else rounded(features.quality, 3),
+        "on_road": verdict.on_road,
+        "gaze": verdict.gaze.value,
+        "neutral_yaw_deg": round(verdict.neutral_yaw_deg, 3),
+        "off_road_s": round(verdict.off_road_s, 3),
+        "window_off_road_s": round(verdict.window_off_road_s, 3),
+        "alerts": [alert.label for alert in record.alerts],
+    }
+
+
+def open_for_writing(path: Path, what: str, newline: str | None = None) -> IO[str]:
+    """`path` opened for line-buffered text writing (folders created); RoadgazeError if not."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return path.open("w", encoding="utf-8", buffering=1, newline=newline)
+    except OSError as exc:
+        raise RoadgazeError(f"cannot write {what} {path}: {exc.strerror or exc}") from None
+
+
+class JsonlWriter(ClosesOnExit):
+    """One JSON object per record and line, flushed line by line (nothing lost on a crash).
+
+    `target` is a path, or an open text stream (e.g. stdout) that is flushed but not closed.
+    """
+
+    def __init__(self, target: str | Path | IO[str]) -> None:
+        self._owned = isinstance(target, (str, Path))
+        if isinstance(target, (str, Path)):
+            self.path: Path | None = Path(target)
+            self._file: IO[str] | None = open_for_writing(self.path, "frame records")
+        else:
+            self.path = None
+            self._file = target
+        self.records = 0
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        assert self._file is not None, "writer is closed"
+        self._file.write(json.dumps(record_fields(record), allow_nan=False) + "\n")
+        if not self._owned:
+            self._file.flush()
+        self.records += 1
+
+    def close(self) -> None:
+        if self._file is not None:
+            if self._owned:
+                self._file.close()
+            else:
+                self._file.flush()
+            self._file = None
+
+
+class CsvWriter(ClosesOnExit):
+    """The same records as CSV; empty cells for null."""
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self._file: IO[str] | None = open_for_writing(self.path, "CSV", newline="")
+        self._writer: csv.DictWriter[str] | None = None
+        self.records = 0
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        assert self._file is not None, "writer is closed"
+        fields = record_fields(record)
+        if self._writer is None:
+            self._writer = csv.DictWriter(self._file, fieldnames=list(fields))
+            self._writer.writeheader()
+        self._writer.writerow({k: "" if v is None else v for k, v in fields.items()})
+        self.records += 1
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None

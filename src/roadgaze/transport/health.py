@@ -1,0 +1,181 @@
+"""The service's health: counters, status and problems, answered on the `state` key.
+
+`Health` is a pipeline sink. It counts frames, faces and alerts, logs each alert once, notices
+when the Zenoh link comes or goes, and builds the `StateMessage` the state queryable answers
+(thread-safe: it reads only immutable records and plain counters).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import Literal
+
+from roadgaze.capture import FrameSource
+from roadgaze.config import Config
+from roadgaze.monitor import initial_state, verdict_of
+from roadgaze.transport.keys import Keys
+from roadgaze.transport.messages import (
+    AlertMessage,
+    MonitorSnapshot,
+    StateMessage,
+    TransportStatus,
+)
+from roadgaze.transport.publisher import MessageLink
+from roadgaze.types import Alert, Frame, FrameRecord
+
+log = logging.getLogger("roadgaze.daemon")
+
+Status = Literal["starting", "running", "degraded", "stopping", "stopped"]
+LINK_CHECK_PERIOD_S = 1.0
+RECENT_ALERTS = 100
+"""Alerts kept for inspection; older ones are only counted (memory stays flat)."""
+
+
+class Health:
+    """Sink keeping what the state query answers; `state_message()` may be called any time."""
+
+    def __init__(
+        self,
+        config: Config,
+        keys: Keys,
+        link: MessageLink | None,
+        source_label: str,
+        wall_clock: Callable[[], float] = time.time,
+    ) -> None:
+        self.config = config
+        self.keys = keys
+        self.link = link
+        self.source_label = source_label
+        self._wall_clock = wall_clock
+        self._started = time.monotonic()
+        self.status: Status = "starting"
+        self.source: FrameSource | None = None
+        """The open frame source, read for its status (camera unavailable, lost, ended)."""
+        self.frames = 0
+        self.faces = 0
+        self.alerts_raised = 0
+        self.recent_alerts: deque[Alert] = deque(maxlen=RECENT_ALERTS)
+        self.last: FrameRecord | None = None
+        self._initial_verdict = verdict_of(config.monitor, initial_state(config.monitor))
+        self._link_connected: bool | None = None
+        self._link_checked_at = -math.inf
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self.last = record
+        self.frames += 1
+        self.faces += int(record.sample.face)
+        if self.status == "starting":
+            self.status = "running"
+        for alert in record.alerts:
+            message = AlertMessage.from_alert(
+                alert, self.keys.vehicle_id, self.alerts_raised, self._wall_clock()
+            )
+            self.alerts_raised += 1
+            self.recent_alerts.append(alert)
+            log.info(
+                "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)",
+                alert.kind.value,
+                alert.level.value,
+                alert.t_s,
+                alert.off_road_s,
+                alert.window_off_road_s,
+                extra={"alert": message.model_dump(mode="json", by_alias=True)},
+            )
+        self._watch_link()
+
+    def _watch_link(self) -> None:
+        """Log when the Zenoh link comes or goes (checked at most once a second)."""
+        now = time.monotonic()
+        if self.link is None or now - self._link_checked_at < LINK_CHECK_PERIOD_S:
+            return
+        self._link_checked_at = now
+        connected = self.link.status().connected
+        if connected != self._link_connected:
+            if connected:
+                again = " again" if self._link_connected is False else ""
+                log.info("zenoh connected: publishing to subscribers%s", again)
+            else:
+                log.warning("zenoh not connected: monitoring goes on, state is degraded")
+            self._link_connected = connected
+
+    def _speed(self) -> tuple[float | None, Literal["none", "waiting", "fresh", "stale"]]:
+        speed = None if self.link is None else self.link.speed
+        if speed is None:
+            return None, "none"
+        return speed.current()
+
+    def state_message(self) -> StateMessage:
+        """The current state; safe to call from Zenoh's callback thread."""
+        record = self.last  # immutable: one consistent snapshot
+        speed_kmh, speed_source = self._speed()
+        transport = (
+            self.link.status()
+            if self.link is not None
+            else TransportStatus(mode=self.config.zenoh.mode, session_open=False, connected=False)
+        )
+        problems: list[str] = []
+        source_status = "opening"
+        camera_reopens = 0
+        if self.source is not None:
+            current = self.source.status
+            source_status = current.state
+            camera_reopens = current.reopen_attempts
+            if not current.connected:
+                problems.append(current.message or "camera lost; reconnecting")
+        if self.link is not None and not transport.connected:
+            problems.append("zenoh not connected")
+        status = self.status
+        if status in ("starting", "running") and problems:
+            status = "degraded"
+        monitor = self.config.monitor
+        verdict = self._initial_verdict if record is None else record.verdict
+        return StateMessage(
+            vehicle_id=self.keys.vehicle_id,
+            wall_time=self._wall_clock(),
+            status=status,
+            problems=problems,
+            t_s=None if record is None else record.t_s,
+            uptime_s=time.monotonic() - self._started,
+            source=self.source_label,
+            source_status=source_status,
+            frames=self.frames,
+            faces=self.faces,
+            camera_reopens=camera_reopens,
+            transport=transport,
+            monitor=MonitorSnapshot(
+                gaze=verdict.gaze,
+                on_road=verdict.on_road is not False,
+                neutral_yaw_deg=verdict.neutral_yaw_deg,
+                yaw_deg=verdict.yaw_deg,
+                off_road_s=verdict.off_road_s,
+                window_off_road_s=verdict.window_off_road_s,
+                unavailable_s=verdict.unavailable_s,
+                vats_armed=verdict.vats_armed,
+                active_alerts=[kind.value for kind in verdict.active],
+                moving=verdict.moving,
+                speed_kmh=speed_kmh,
+                speed_source=speed_source,
+                alert_counts=dict(verdict.alert_counts),
+            ),
+            config={
+                "monitor": monitor.model_dump(mode="json"),
+                "keys": {
+                    "yaw": self.keys.yaw,
+                    "alert": self.keys.alert,
+                    "alive": self.keys.alive,
+                    "state": self.keys.state,
+                    "speed": self.keys.speed,
+                },
+                "zenoh_mode": self.config.zenoh.mode,
+            },
+        )
+
+    def state_json(self) -> bytes:
+        return self.state_message().to_json_bytes()
+
+    def close(self) -> None:
+        """Nothing to release."""

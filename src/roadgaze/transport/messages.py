@@ -1,0 +1,179 @@
+"""The messages roadgaze publishes on Zenoh, as pydantic models (pure: no Zenoh import).
+
+Payloads are these models serialised as JSON (`application/json`); each names its schema and
+version in the field `schema`. `roadgaze schema` prints their JSON Schemas. Messages are built
+from the frame record (`YawMessage.from_record`) and the monitor's alerts
+(`AlertMessage.from_alert`).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from roadgaze.types import Alert, AlertKind, AlertLevel, FrameRecord, Gaze
+
+YAW_SCHEMA = "roadgaze.yaw/1"
+ALERT_SCHEMA = "roadgaze.alert/1"
+STATE_SCHEMA = "roadgaze.state/1"
+
+
+class _Message(BaseModel):
+    model_config = ConfigDict(
+        frozen=True,
+        populate_by_name=True,
+        extra="forbid",
+        json_schema_serialization_defaults_required=True,  # every field is always published
+    )
+
+    def to_json_bytes(self) -> bytes:
+        return self.model_dump_json(by_alias=True).encode("utf-8")
+
+
+class YawMessage(_Message):
+    """One frame's head yaw and road-ahead decision."""
+
+    schema_id: Literal["roadgaze.yaw/1"] = Field(default="roadgaze.yaw/1", alias="schema")
+    vehicle_id: str
+    seq: int = Field(ge=0, description="Per-key sequence number, from 0 at start.")
+    t_s: float = Field(
+        description="Source timeline: video time in replay, seconds since start live."
+    )
+    wall_time: float = Field(description="Unix time (s) when the message was built.")
+    frame: int = Field(ge=0)
+    face: bool
+    yaw_deg: float | None = Field(description="Smoothed yaw, > 0 = head turned to driver's left.")
+    yaw_raw_deg: float | None
+    yaw_rate_dps: float | None = None
+    on_road: bool | None = Field(description="Road ahead; None when no face and not turned away.")
+    gaze: Gaze
+    neutral_yaw_deg: float
+    n_faces: int = Field(default=0, ge=0)
+
+    @classmethod
+    def from_record(
+        cls, record: FrameRecord, vehicle_id: str, seq: int, wall_time: float
+    ) -> YawMessage:
+        """The yaw message of one frame record."""
+        sample, verdict = record.sample, record.verdict
+        return cls(
+            vehicle_id=vehicle_id,
+            seq=seq,
+            t_s=sample.t_s,
+            wall_time=wall_time,
+            frame=sample.frame,
+            face=sample.face,
+            yaw_deg=sample.yaw_deg,
+            yaw_raw_deg=sample.yaw_raw_deg,
+            yaw_rate_dps=sample.yaw_rate_dps,
+            on_road=verdict.on_road,
+            gaze=verdict.gaze,
+            neutral_yaw_deg=verdict.neutral_yaw_deg,
+            n_faces=sample.n_faces,
+        )
+
+
+class AlertMessage(_Message):
+    """One monitor event (see docs/monitor.md)."""
+
+    schema_id: Literal["roadgaze.alert/1"] = Field(default="roadgaze.alert/1", alias="schema")
+    vehicle_id: str
+    seq: int = Field(ge=0)
+    kind: AlertKind
+    level: AlertLevel
+    t_s: float
+    wall_time: float
+    yaw_deg: float | None
+    off_road_s: float = Field(ge=0, description="Current continuous off-road time.")
+    window_off_road_s: float = Field(ge=0, description="Off-road time in the VATS window.")
+    unavailable_s: float = Field(default=0.0, ge=0)
+    speed_kmh: float | None = None
+    clears: list[AlertKind] = Field(
+        default_factory=list, description="For 'cleared': the alerts it ends."
+    )
+
+    @classmethod
+    def from_alert(cls, alert: Alert, vehicle_id: str, seq: int, wall_time: float) -> AlertMessage:
+        """The wire form of one monitor alert."""
+        return cls(
+            vehicle_id=vehicle_id,
+            seq=seq,
+            kind=alert.kind,
+            level=alert.level,
+            t_s=alert.t_s,
+            wall_time=wall_time,
+            yaw_deg=alert.yaw_deg,
+            off_road_s=max(0.0, alert.off_road_s),
+            window_off_road_s=max(0.0, alert.window_off_road_s),
+            unavailable_s=max(0.0, alert.unavailable_s),
+            speed_kmh=alert.speed_kmh,
+            clears=[kind for kind in alert.clears if kind is not AlertKind.CLEARED],
+        )
+
+
+class TransportStatus(_Message):
+    mode: Literal["peer", "client"]
+    session_open: bool
+    connected: bool
+    """Session open and, when `connect` endpoints are configured, at least one is connected."""
+    peers: int = 0
+    routers: int = 0
+    session_reopens: int = 0
+    yaw_sent: int = 0
+    alerts_sent: int = 0
+    not_sent: int = 0
+    pending_alerts: int = 0
+    speed_messages: int = 0
+    speed_rejected: int = 0
+
+
+class MonitorSnapshot(_Message):
+    gaze: Gaze
+    on_road: bool
+    neutral_yaw_deg: float
+    yaw_deg: float | None
+    off_road_s: float
+    window_off_road_s: float
+    unavailable_s: float
+    vats_armed: bool
+    active_alerts: list[str]
+    moving: bool
+    speed_kmh: float | None
+    speed_source: Literal["none", "waiting", "fresh", "stale"]
+    alert_counts: dict[str, int]
+
+
+class StateMessage(_Message):
+    """Answer of the `state` queryable: health, monitor state, counters and config summary."""
+
+    schema_id: Literal["roadgaze.state/1"] = Field(default="roadgaze.state/1", alias="schema")
+    vehicle_id: str
+    wall_time: float
+    status: Literal["starting", "running", "degraded", "stopping", "stopped"]
+    problems: list[str] = Field(default_factory=list, description="Why the status is degraded.")
+    t_s: float | None = Field(description="Timestamp of the last sample processed.")
+    uptime_s: float
+    source: str
+    source_status: str
+    frames: int
+    faces: int
+    camera_reopens: int = 0
+    transport: TransportStatus
+    monitor: MonitorSnapshot
+    config: dict[str, Any]
+
+
+MESSAGE_MODELS: dict[str, type[_Message]] = {
+    "yaw": YawMessage,
+    "alert": AlertMessage,
+    "state": StateMessage,
+}
+
+
+def json_schemas() -> dict[str, dict[str, Any]]:
+    """The JSON Schema of every published message, by name."""
+    return {
+        name: model.model_json_schema(by_alias=True, mode="serialization")
+        for name, model in MESSAGE_MODELS.items()
+    }

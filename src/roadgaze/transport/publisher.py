@@ -1,0 +1,56 @@
+"""The bus sink: every frame record's yaw message and each of its alerts, onto a message link."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Protocol
+
+from roadgaze.transport.messages import AlertMessage, TransportStatus, YawMessage
+from roadgaze.transport.speed import SpeedInput
+from roadgaze.types import Frame, FrameRecord
+
+
+class MessageLink(Protocol):
+    """Where messages go: `ZenohLink` in production, a list in tests."""
+
+    speed: SpeedInput | None
+
+    def publish_yaw(self, message: YawMessage) -> None: ...
+
+    def publish_alert(self, message: AlertMessage) -> None: ...
+
+    def status(self) -> TransportStatus: ...
+
+
+class BusPublisher:
+    """Pipeline sink: publishes one `YawMessage` per record and one `AlertMessage` per alert.
+
+    Sequence numbers count per key from 0; `wall_time` is stamped when the message is built.
+    """
+
+    def __init__(
+        self,
+        vehicle_id: str,
+        link: MessageLink,
+        wall_clock: Callable[[], float] = time.time,
+    ) -> None:
+        self.vehicle_id = vehicle_id
+        self.link = link
+        self._wall_clock = wall_clock
+        self._yaw_seq = 0
+        self._alert_seq = 0
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        wall_time = self._wall_clock()
+        self.link.publish_yaw(
+            YawMessage.from_record(record, self.vehicle_id, self._yaw_seq, wall_time)
+        )
+        self._yaw_seq += 1
+        for alert in record.alerts:
+            message = AlertMessage.from_alert(alert, self.vehicle_id, self._alert_seq, wall_time)
+            self._alert_seq += 1
+            self.link.publish_alert(message)
+
+    def close(self) -> None:
+        """Nothing to release: the link is owned by whoever opened it."""

@@ -1,0 +1,179 @@
+"""The shared fakes of the swappable edges: camera, detector, frame source and message link.
+
+Also `record_of`, a frame record around a pose sample as the monitor would leave it with no
+history (for writer and publisher tests).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+import cv2
+import numpy as np
+
+from roadgaze.capture import SourceInfo, SourceStatus
+from roadgaze.config import MonitorConfig
+from roadgaze.monitor import initial_state, verdict_of
+from roadgaze.pose.geometry import forward_model
+from roadgaze.transport import AlertMessage, SpeedInput, TransportStatus, YawMessage
+from roadgaze.types import (
+    Alert,
+    ClosesOnExit,
+    Detection,
+    FaceFeatures,
+    Frame,
+    FrameRecord,
+    PoseSample,
+    Verdict,
+)
+
+
+def numbered_image(index: int, size: tuple[int, int] = (160, 120)) -> np.ndarray:
+    """A grey image with its number drawn on it, so frames can be told apart."""
+    width, height = size
+    image = np.full((height, width, 3), (index * 7) % 256, np.uint8)
+    cv2.putText(image, str(index), (10, 80), cv2.FONT_HERSHEY_SIMPLEX, 2, (255, 255, 255), 3)
+    return image
+
+
+class FakeCamera:
+    """Stands in for `cv2.VideoCapture(device, CAP_V4L2)`.
+
+    Serves `frames` reads (None: without end; then every read fails, as if unplugged), one every
+    `period_s`: copies of `image`, or numbered images. `opened=False` is a device that cannot be
+    opened. Settings and the release are appended to `log`.
+    """
+
+    def __init__(
+        self,
+        frames: int | None = None,
+        *,
+        image: np.ndarray | None = None,
+        opened: bool = True,
+        period_s: float = 0.002,
+        log: list[Any] | None = None,
+    ) -> None:
+        self.frames_left = frames
+        self.image = image
+        self.opened = opened
+        self.period_s = period_s
+        self.log = log if log is not None else []
+        self.served = 0
+
+    def isOpened(self) -> bool:  # noqa: N802 (OpenCV's name)
+        return self.opened
+
+    def read(self) -> tuple[bool, Any]:
+        time.sleep(self.period_s)  # a camera paces its frames; keeps the fake from spinning
+        if self.frames_left is not None:
+            if self.frames_left <= 0:
+                return False, None
+            self.frames_left -= 1
+        self.served += 1
+        return True, numbered_image(self.served) if self.image is None else self.image.copy()
+
+    def get(self, prop_id: int) -> float:
+        if self.image is not None:
+            return 0.0
+        return {cv2.CAP_PROP_FRAME_WIDTH: 640.0, cv2.CAP_PROP_FRAME_HEIGHT: 480.0}.get(prop_id, 0.0)
+
+    def set(self, prop_id: int, value: float) -> bool:
+        self.log.append((prop_id, value))
+        return True
+
+    def release(self) -> None:
+        self.log.append("release")
+
+
+def face_at(yaw_deg: float) -> FaceFeatures:
+    """A face whose boundaries and centre come from the paper's forward model."""
+    projected = forward_model(yaw_deg, half_width_px=80.0, pivot_x_px=320.0)
+    return FaceFeatures(
+        x_left_px=float(projected.x_left),
+        x_right_px=float(projected.x_right),
+        x_center_px=float(projected.x_center),
+        roll_deg=0.0,
+        box_px=(220.0, 140.0, 420.0, 380.0),
+        quality=1.0,
+        landmarks_px=np.zeros((0, 3), np.float32),
+    )
+
+
+class ScriptedDetector:
+    """Fake `LandmarkDetector`: the true yaw per call (None: no face), checking time order."""
+
+    def __init__(self, yaws_deg: list[float | None]) -> None:
+        self.yaws_deg = list(yaws_deg)
+        self.calls: list[float | None] = []
+        self.closed = False
+
+    def detect(self, image: np.ndarray, t_s: float | None = None) -> Detection:
+        assert t_s is not None and (not self.calls or t_s > (self.calls[-1] or -1.0))
+        yaw_deg = self.yaws_deg[len(self.calls)]
+        self.calls.append(t_s)
+        if yaw_deg is None:
+            return Detection(faces=(), driver_index=None)
+        return Detection(faces=(face_at(yaw_deg),), driver_index=0)
+
+    def close(self) -> None:
+        self.closed = True
+
+
+class ListSource(ClosesOnExit):
+    """Fake `FrameSource` over `count` blank frames at `fps`."""
+
+    def __init__(self, count: int, fps: float = 30.0) -> None:
+        self.count, self.fps = count, fps
+        self._status = SourceStatus()
+
+    @property
+    def info(self) -> SourceInfo:
+        return SourceInfo("list", False, self.fps, self.count, 64, 48)
+
+    @property
+    def status(self) -> SourceStatus:
+        return self._status
+
+    def __iter__(self) -> Iterator[Frame]:
+        for i in range(self.count):
+            self._status = SourceStatus(frames_delivered=i + 1)
+            yield Frame(index=i, t_s=i / self.fps, image=np.zeros((48, 64, 3), np.uint8))
+
+    def close(self) -> None:
+        return None
+
+
+@dataclass
+class FakeLink:
+    """Fake `MessageLink`: keeps every message; `connected` is what its status reports."""
+
+    yaw: list[YawMessage] = field(default_factory=list)
+    alerts: list[AlertMessage] = field(default_factory=list)
+    connected: bool = True
+    speed: SpeedInput | None = None
+
+    def publish_yaw(self, message: YawMessage) -> None:
+        self.yaw.append(message)
+
+    def publish_alert(self, message: AlertMessage) -> None:
+        self.alerts.append(message)
+
+    def status(self) -> TransportStatus:
+        return TransportStatus(mode="peer", session_open=True, connected=self.connected)
+
+
+BLANK_FRAME = Frame(0, 0.0, np.zeros((4, 4, 3), np.uint8))
+"""A frame for sinks that ignore the image."""
+
+
+def record_of(
+    sample: PoseSample, verdict: Verdict | None = None, alerts: tuple[Alert, ...] = ()
+) -> FrameRecord:
+    """A frame record of `sample`; the verdict defaults to the monitor's initial one."""
+    if verdict is None:
+        config = MonitorConfig()
+        verdict = verdict_of(config, initial_state(config))
+    return FrameRecord(sample=sample, verdict=verdict, alerts=alerts)

@@ -1,0 +1,320 @@
+"""The inattention monitor on synthetic timelines with known event times."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from collections.abc import Callable
+
+import pytest
+
+from repo_paths import child_env
+from roadgaze.config import MonitorConfig
+from roadgaze.monitor import (
+    Alert,
+    AlertKind,
+    AlertLevel,
+    Gaze,
+    Monitor,
+    initial_state,
+    step,
+)
+from roadgaze.types import PoseSample
+
+FPS = 30.0
+FRAME_S = 1.0 / FPS
+FIXED = MonitorConfig(neutral_yaw_deg=0.0)
+"""Neutral fixed at 0 so event times do not depend on learning."""
+
+YawAt = Callable[[float], float | None]
+"""Yaw at time t, None for no face."""
+
+
+def sample(t_s: float, yaw_deg: float | None, frame: int = 0) -> PoseSample:
+    face = yaw_deg is not None
+    return PoseSample(
+        t_s=t_s,
+        frame=frame,
+        face=face,
+        yaw_raw_deg=yaw_deg,
+        yaw_deg=yaw_deg,
+        yaw_rate_dps=0.0 if face else None,
+        yaw_std_deg=1.0 if face else None,
+        n_faces=int(face),
+    )
+
+
+def run(
+    yaw_at: YawAt,
+    duration_s: float,
+    config: MonitorConfig = FIXED,
+    speed_at: Callable[[float], float | None] = lambda t: None,
+) -> tuple[Monitor, list[Alert]]:
+    monitor = Monitor(config)
+    alerts: list[Alert] = []
+    for frame in range(round(duration_s * FPS)):
+        t_s = frame / FPS
+        alerts.extend(monitor.update(sample(t_s, yaw_at(t_s), frame), speed_at(t_s)))
+    return monitor, alerts
+
+
+def glances(
+    starts_s: list[float], length_s: float, yaw_deg: float = 45.0, base_deg: float = 0.0
+) -> YawAt:
+    def yaw_at(t_s: float) -> float:
+        inside = any(start <= t_s + 1e-9 < start + length_s for start in starts_s)
+        return yaw_deg if inside else base_deg
+
+    return yaw_at
+
+
+def kinds(alerts: list[Alert]) -> list[tuple[str, str]]:
+    return [(a.kind.value, a.level.value) for a in alerts]
+
+
+def assert_within_one_frame(actual_s: float, expected_s: float) -> None:
+    assert expected_s - 1e-9 <= actual_s < expected_s + FRAME_S + 1e-9, (actual_s, expected_s)
+
+
+def test_long_distraction_fires_three_seconds_into_a_glance_then_clears() -> None:
+    _, alerts = run(glances([4.0], 4.0), 12.0)
+    assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
+    assert_within_one_frame(alerts[0].t_s, 7.0)
+    assert alerts[0].off_road_s == pytest.approx(3.0, abs=FRAME_S)
+    assert alerts[0].yaw_deg == 45.0
+    assert_within_one_frame(alerts[1].t_s, 8.0)
+    assert alerts[1].clears == (AlertKind.LONG_DISTRACTION,)
+    assert alerts[1].off_road_s == pytest.approx(4.0, abs=FRAME_S)
+
+
+def test_long_distraction_is_raised_to_critical_at_six_seconds() -> None:
+    _, alerts = run(glances([1.0], 8.0), 12.0)
+    assert kinds(alerts) == [
+        ("long_distraction", "warning"),
+        ("long_distraction", "critical"),
+        ("cleared", "info"),
+    ]
+    assert_within_one_frame(alerts[0].t_s, 4.0)
+    assert_within_one_frame(alerts[1].t_s, 7.0)
+    assert_within_one_frame(alerts[2].t_s, 9.0)
+
+
+def test_a_glance_shorter_than_three_seconds_raises_nothing() -> None:
+    _, alerts = run(glances([1.0], 2.9), 6.0)
+    assert alerts == []
+
+
+@pytest.mark.parametrize(
+    ("yaw_sequence", "expected_on_road"),
+    [
+        ([0, 24, 25, 0], [True, True, True, True]),  # <= 25 is road ahead
+        ([0, 26, 0], [True, False, True]),
+        ([0, 26, 22, 20.5, 20, 24], [True, False, False, False, True, True]),  # back at <= 20
+        ([0, -26, -21, -19], [True, False, False, True]),  # symmetric
+        ([0, 26, 24, 26, 24, 26], [True, False, False, False, False, False]),  # no flicker
+    ],
+)
+def test_hysteresis_leaves_at_25_and_returns_at_20(
+    yaw_sequence: list[float], expected_on_road: list[bool]
+) -> None:
+    monitor = Monitor(FIXED)
+    on_road = []
+    for index, yaw in enumerate(yaw_sequence):
+        monitor.update(sample(index * FRAME_S, yaw))
+        on_road.append(monitor.state.on_road)
+    assert on_road == expected_on_road
+
+
+def test_yaw_flickering_around_the_limit_does_not_restart_the_episode() -> None:
+    def yaw_at(t_s: float) -> float:
+        if t_s < 1.0:
+            return 0.0
+        return 26.0 if int(t_s * FPS) % 2 else 23.0  # inside the hysteresis band once off road
+
+    _, alerts = run(yaw_at, 4.5)
+    assert kinds(alerts) == [("long_distraction", "warning")]
+    assert_within_one_frame(alerts[0].t_s, 1.0 + FRAME_S + 3.0)
+
+
+def test_five_short_glances_raise_one_vats_and_no_long_distraction() -> None:
+    starts = [1.0 + 3.5 * k for k in range(5)]  # 2.5 s glances, 1 s between
+    _, alerts = run(glances(starts, 2.5), 20.0)
+    assert kinds(alerts) == [("vats", "warning"), ("cleared", "info")]
+    # 10 s off road is reached at the end of the fourth glance (4 x 2.5 s); the alert raised on
+    # the sample that ends the glance is cleared on the next one.
+    assert_within_one_frame(alerts[0].t_s, starts[3] + 2.5)
+    assert alerts[0].window_off_road_s == pytest.approx(10.0, abs=1e-6)
+    assert_within_one_frame(alerts[1].t_s, starts[3] + 2.5 + FRAME_S)
+
+
+@pytest.mark.parametrize(
+    ("second_start_s", "expected_t_s"),
+    [
+        (26.0, 30.0),  # 6 s + 4 s of the second glance, the first still fully in the window
+        (26.5, None),  # the first glance starts leaving the window before 10 s are reached
+        (24.0, 28.0),
+    ],
+)
+def test_vats_window_edges(second_start_s: float, expected_t_s: float | None) -> None:
+    config = FIXED.model_copy(update={"long_distraction_s": 100.0, "critical_distraction_s": 200.0})
+    _, alerts = run(glances([0.0, second_start_s], 6.0), 34.0, config)
+    vats = [a for a in alerts if a.kind is AlertKind.VATS]
+    if expected_t_s is None:
+        assert vats == []
+    else:
+        assert len(vats) == 1
+        assert_within_one_frame(vats[0].t_s, expected_t_s)
+
+
+@pytest.mark.parametrize(("gap_s", "expected_vats"), [(1.9, 1), (2.1, 2)])
+def test_vats_rearms_only_after_two_seconds_on_road(gap_s: float, expected_vats: int) -> None:
+    first = [0.5 + 3.5 * k for k in range(4)]  # fires at the end of the fourth glance
+    second_start = first[-1] + 2.5 + gap_s
+    _, alerts = run(glances([*first, second_start], 2.5), second_start + 4.0)
+    vats = [a for a in alerts if a.kind is AlertKind.VATS]
+    assert len(vats) == expected_vats
+    if expected_vats == 2:  # the window still holds >= 10 s: fires on the first off-road sample
+        assert_within_one_frame(vats[1].t_s, second_start)
+
+
+@pytest.mark.parametrize(
+    ("speed_kmh", "min_speed_kmh", "expect_alerts"),
+    [
+        (None, 20.0, True),  # no speed known: taken as moving
+        (50.0, 20.0, True),
+        (20.0, 20.0, False),  # alerts only above the limit
+        (10.0, 20.0, False),
+        (10.0, 5.0, True),  # configurable
+        (0.0, 0.0, False),
+    ],
+)
+def test_speed_gating(speed_kmh: float | None, min_speed_kmh: float, expect_alerts: bool) -> None:
+    config = FIXED.model_copy(update={"min_speed_kmh": min_speed_kmh})
+    _, alerts = run(glances([1.0], 4.0), 6.0, config, speed_at=lambda t: speed_kmh)
+    assert kinds(alerts) == (
+        [("long_distraction", "warning"), ("cleared", "info")] if expect_alerts else []
+    )
+
+
+def test_no_vats_when_the_window_fills_as_the_vehicle_stops() -> None:
+    starts = [1.0 + 3.5 * k for k in range(4)]  # 10 s off road exactly at t = 14.0 s
+    speed = lambda t: 50.0 if t < starts[3] + 2.5 else 5.0  # noqa: E731
+    _, alerts = run(glances(starts, 2.5), 16.0, speed_at=speed)
+    assert alerts == []
+
+
+def test_off_road_time_counts_only_from_when_the_vehicle_moves() -> None:
+    speed = lambda t: 10.0 if t < 3.0 else 40.0  # noqa: E731
+    _, alerts = run(glances([1.0], 7.0), 9.0, speed_at=speed)
+    assert kinds(alerts)[0] == ("long_distraction", "warning")
+    assert_within_one_frame(alerts[0].t_s, 6.0)
+
+
+def test_face_lost_after_a_turn_is_off_road_not_unavailable() -> None:
+    def yaw_at(t_s: float) -> float | None:
+        if t_s < 1.0:
+            return 0.0
+        if t_s < 1.5:
+            return 70.0 * (t_s - 1.0) / 0.5  # turning: passes 25 deg at about t = 1.18 s
+        if t_s < 6.0:
+            return None  # profile: the landmarker loses the face
+        return 0.0
+
+    monitor, alerts = run(yaw_at, 8.0)
+    assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
+    first_off = next(k / FPS for k in range(300) if (yaw_at(k / FPS) or 0.0) > 25.0)
+    assert_within_one_frame(alerts[0].t_s, first_off + 3.0)
+    assert_within_one_frame(alerts[1].t_s, 6.0)
+    assert monitor.state.gaze is Gaze.ON_ROAD
+
+
+@pytest.mark.parametrize(("lost_s", "expected"), [(1.9, []), (2.5, ["driver_unavailable"])])
+def test_face_lost_looking_ahead_is_unavailable_after_two_seconds(
+    lost_s: float, expected: list[str]
+) -> None:
+    def yaw_at(t_s: float) -> float | None:
+        return None if 1.0 <= t_s < 1.0 + lost_s else 5.0
+
+    _, alerts = run(yaw_at, 6.0)
+    assert [a.kind.value for a in alerts] == ([*expected, "cleared"] if expected else [])
+    if expected:
+        assert_within_one_frame(alerts[0].t_s, 3.0)
+        assert alerts[0].unavailable_s == pytest.approx(2.0, abs=FRAME_S)
+        assert alerts[1].clears == (AlertKind.DRIVER_UNAVAILABLE,)
+
+
+def test_no_face_from_the_start_is_unavailable() -> None:
+    _, alerts = run(lambda t: None, 3.0)
+    assert kinds(alerts) == [("driver_unavailable", "warning")]
+    assert_within_one_frame(alerts[0].t_s, 2.0)
+
+
+def test_explicit_turn_away_angle() -> None:
+    config = FIXED.model_copy(update={"turn_away_deg": 50.0})
+
+    def yaw_at(t_s: float) -> float | None:
+        return 0.0 if t_s < 1.0 else (40.0 if t_s < 1.5 else None)
+
+    _, alerts = run(yaw_at, 4.0, config)
+    # Lost at 40 deg < 50 deg: unexplained, so unavailable 2 s after the loss.
+    assert [a.kind for a in alerts] == [AlertKind.DRIVER_UNAVAILABLE]
+    assert_within_one_frame(alerts[0].t_s, 3.5)
+
+
+def test_neutral_is_learned_slowly_from_on_road_samples() -> None:
+    config = MonitorConfig()  # learning on, time constant 60 s
+    monitor, alerts = run(lambda t: 18.0, 120.0, config)
+    assert alerts == []
+    # After two time constants the neutral has moved 1 - e^-2 of the way.
+    assert monitor.state.neutral_yaw_deg == pytest.approx(18.0 * (1 - 2.718281828**-2), abs=0.05)
+    monitor.update(sample(120.0, 18.0 + 24.0))  # 24 deg from neutral would be off road at 0
+    assert monitor.state.on_road is False  # 42 - 15.6 = 26.4 > 25
+    monitor.update(sample(121.0, 37.0))
+    assert monitor.state.on_road is False  # 37 - 15.6 = 21.4: inside the hysteresis band
+    monitor.update(sample(122.0, 35.0))
+    assert monitor.state.on_road is True  # 35 - 15.6 = 19.4 <= 20
+
+
+def test_neutral_is_clamped_and_fixed_neutral_is_used_as_is() -> None:
+    config = MonitorConfig(neutral_limit_deg=10.0)
+    monitor, _ = run(lambda t: 20.0, 600.0, config)
+    assert monitor.state.neutral_yaw_deg == pytest.approx(10.0)
+    fixed = MonitorConfig(neutral_yaw_deg=30.0)
+    monitor, _ = run(lambda t: 30.0, 10.0, fixed)
+    assert monitor.state.neutral_yaw_deg == 30.0
+    assert monitor.state.on_road is True
+    monitor.update(sample(10.0, 0.0))
+    assert monitor.state.on_road is False
+
+
+def test_step_is_pure_and_ignores_time_going_backwards() -> None:
+    state0 = initial_state(FIXED)
+    state1, alerts = step(FIXED, state0, sample(1.0, 40.0), None)
+    assert state0.t_s is None and state1.t_s == 1.0 and alerts == ()
+    assert step(FIXED, state0, sample(1.0, 40.0), None) == (state1, ())
+    assert step(FIXED, state1, sample(0.5, 0.0), None) == (state1, ())
+    assert step(FIXED, state1, sample(1.0, 0.0), None) == (state1, ())
+
+
+def test_counters_and_levels() -> None:
+    monitor, alerts = run(glances([0.5], 7.0), 9.0)
+    assert [a.level for a in alerts] == [AlertLevel.WARNING, AlertLevel.CRITICAL, AlertLevel.INFO]
+    assert dict(monitor.state.alert_counts) == {
+        "long_distraction:warning": 1,
+        "long_distraction:critical": 1,
+        "cleared:info": 1,
+    }
+    assert monitor.state.samples == 270
+
+
+def test_monitor_imports_no_heavy_modules() -> None:
+    code = (
+        "import sys, roadgaze.monitor; "
+        "bad = {'cv2', 'mediapipe', 'zenoh'} & set(sys.modules); "
+        "sys.exit(1 if bad else 0)"
+    )
+    env = child_env()
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, timeout=60, env=env, check=False
+    )
+    assert result.returncode == 0, result.stderr

@@ -1,0 +1,154 @@
+"""YawSmoother on synthetic tracks with known truth (noise, step, gaps, outliers)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from roadgaze.config import SmoothingConfig
+from roadgaze.pose.smoothing import YawSmoother
+
+FPS = 30.0
+
+
+def smooth(
+    truth_deg: np.ndarray,
+    noise_std_deg: float = 0.0,
+    seed: int = 0,
+    config: SmoothingConfig | None = None,
+    missing: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, YawSmoother]:
+    """Smoothed yaw and std per frame (NaN where there is no track)."""
+    rng = np.random.default_rng(seed)
+    smoother = YawSmoother(config or SmoothingConfig())
+    yaw, std = np.full(len(truth_deg), np.nan), np.full(len(truth_deg), np.nan)
+    for i, value in enumerate(truth_deg):
+        measured = None if missing is not None and missing[i] else value
+        if measured is not None:
+            measured += noise_std_deg * rng.standard_normal()
+        result = smoother.update(i / FPS, measured)
+        if result is not None:
+            yaw[i], std[i] = result.yaw_deg, result.yaw_std_deg
+    return yaw, std, smoother
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_constant_yaw_noise_is_reduced_by_at_least_40_percent(seed: int) -> None:
+    truth = np.full(300, 12.0)
+    yaw, _, _ = smooth(truth, noise_std_deg=3.0, seed=seed)
+    residual_std = float(np.std(yaw[30:] - truth[30:]))
+    assert residual_std <= 0.6 * 3.0
+    assert abs(float(np.mean(yaw[30:])) - 12.0) < 0.5
+
+
+@pytest.mark.parametrize("direction", [+1.0, -1.0])
+def test_30_degree_step_settles_within_0_3_s(direction: float) -> None:
+    step_frame = 30
+    truth = np.r_[np.zeros(step_frame), np.full(60, 30.0 * direction)]
+    yaw, _, _ = smooth(truth)
+    error = np.abs(yaw - truth)[step_frame:]
+    outside = np.nonzero(error > 3.0)[0]  # 10 % of the step
+    settle_s = 0.0 if len(outside) == 0 else (outside[-1] + 1) / FPS
+    assert settle_s <= 0.3
+    assert float(np.max(error[int(0.3 * FPS) :])) < 0.5
+
+
+def test_noisy_30_degree_step_is_followed_within_0_3_s() -> None:
+    truth = np.r_[np.zeros(30), np.full(90, 30.0)]
+    for seed in range(5):
+        yaw, _, _ = smooth(truth, noise_std_deg=3.0, seed=seed)
+        late = yaw[30 + int(0.3 * FPS) :] - truth[30 + int(0.3 * FPS) :]
+        assert abs(float(np.mean(late))) < 1.5
+        assert float(np.max(np.abs(late))) < 8.0
+
+
+def test_small_step_inside_the_gate_is_tracked_without_rejection() -> None:
+    truth = np.r_[np.zeros(30), np.full(60, 8.0)]
+    yaw, _, smoother = smooth(truth)
+    assert smoother.state.rejected_total == 0
+    assert abs(yaw[-1] - 8.0) < 0.2
+
+
+def test_one_second_gap_is_bridged_and_reacquired() -> None:
+    truth = np.r_[np.full(60, 10.0), np.full(30, 10.0), np.full(60, 20.0)]
+    missing = np.zeros(len(truth), bool)
+    missing[60:90] = True  # 1 s without a face at 30 fps
+    yaw, std, smoother = smooth(truth, missing=missing)
+    gap_std = std[60:90]
+    assert not np.any(np.isnan(yaw[60:90])), "the gap must be bridged by prediction"
+    assert np.all(np.diff(gap_std) > 0), "variance must grow while predicting"
+    assert gap_std[-1] > 3 * std[59]
+    np.testing.assert_allclose(yaw[60:90], 10.0, atol=0.1)
+    assert smoother.state.reinitialisations == 0
+    assert abs(yaw[-1] - 20.0) < 0.2, "re-acquired after the gap"
+    assert np.all(np.abs(yaw[90 + int(0.3 * FPS) :] - 20.0) < 2.0)
+
+
+def test_long_gap_drops_the_track_and_restarts_on_the_next_face() -> None:
+    config = SmoothingConfig(reinit_gap_s=1.5)
+    truth = np.r_[np.full(30, -20.0), np.full(60, 0.0), np.full(10, 35.0)]
+    missing = np.zeros(len(truth), bool)
+    missing[30:90] = True  # 2 s without a face
+    yaw, _, smoother = smooth(truth, missing=missing, config=config)
+    last_face_t = 29 / FPS
+    dropped = [i for i in range(30, 90) if np.isnan(yaw[i])]
+    assert dropped and dropped[0] / FPS - last_face_t > 1.5
+    assert all(np.isnan(yaw[i]) for i in range(dropped[0], 90))
+    assert yaw[90] == pytest.approx(35.0)
+    assert smoother.state.reinitialisations == 1
+
+
+def test_single_outlier_is_gated_out() -> None:
+    truth = np.full(60, 5.0)
+    smoother = YawSmoother()
+    results = []
+    for i, value in enumerate(truth):
+        measured = 60.0 if i == 40 else float(value)
+        result = smoother.update(i / FPS, measured)
+        assert result is not None
+        results.append(result.yaw_deg)
+    assert abs(results[40] - 5.0) < 0.5
+    assert smoother.state.rejected_total == 1
+    assert smoother.state.reinitialisations == 0
+
+
+def test_no_face_before_first_face_gives_none_and_nan_counts_as_no_face() -> None:
+    smoother = YawSmoother()
+    assert smoother.update(0.0, None) is None
+    assert smoother.update(0.1, float("nan")) is None
+    first = smoother.update(0.2, 7.0)
+    assert first is not None
+    assert first.yaw_deg == 7.0
+    assert first.yaw_rate_dps == 0.0
+    assert first.yaw_std_deg == pytest.approx(SmoothingConfig().initial_std_deg)
+
+
+def test_rate_follows_a_ramp() -> None:
+    truth = np.linspace(0.0, 60.0, 61)  # 60 deg over 2 s = 30 deg/s... at 30 fps: 1 deg/frame
+    smoother = YawSmoother()
+    result = None
+    for i, value in enumerate(truth):
+        result = smoother.update(i / FPS, float(value))
+    assert result is not None
+    assert result.yaw_rate_dps == pytest.approx(30.0, abs=1.0)
+    assert result.yaw_deg == pytest.approx(60.0, abs=0.5)
+
+
+def test_dt_comes_from_timestamps() -> None:
+    """The same track sampled at 10 fps and 30 fps ends at the same rate estimate."""
+    rates = []
+    for fps in (10.0, 30.0):
+        smoother = YawSmoother()
+        result = None
+        for i in range(int(3 * fps)):
+            result = smoother.update(i / fps, 20.0 * i / fps)
+        assert result is not None
+        rates.append(result.yaw_rate_dps)
+    np.testing.assert_allclose(rates, 20.0, atol=0.5)
+
+
+def test_non_increasing_time_raises() -> None:
+    smoother = YawSmoother()
+    smoother.update(1.0, 0.0)
+    with pytest.raises(ValueError, match="increase"):
+        smoother.update(1.0, 0.0)

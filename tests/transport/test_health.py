@@ -1,0 +1,128 @@
+"""The health and publisher sinks with a fake link: sequence numbers, alerts, degraded states."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+
+import jsonschema
+import pytest
+
+from fakes import BLANK_FRAME, FakeLink, ListSource, ScriptedDetector
+from roadgaze.capture import SourceStatus
+from roadgaze.config import Config
+from roadgaze.monitor import Monitor
+from roadgaze.outputs import verdict_text
+from roadgaze.pipeline import Pipeline
+from roadgaze.transport import (
+    BusPublisher,
+    Health,
+    Keys,
+    SpeedInput,
+    YawMessage,
+    json_schemas,
+)
+from roadgaze.types import FrameRecord, PoseSample
+
+SCHEMAS = json_schemas()
+FIXED = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
+
+
+def sample(t_s: float, yaw_deg: float | None) -> PoseSample:
+    face = yaw_deg is not None
+    return PoseSample(t_s, round(t_s * 30), face, yaw_deg, yaw_deg, 0.0, 1.0, n_faces=int(face))
+
+
+def records(
+    config: Config, yaws: list[tuple[float, float | None]], speed_kmh: float | None = None
+) -> Iterator[FrameRecord]:
+    """The frame records the monitor stage makes of (t_s, yaw) samples."""
+    monitor = Monitor(config.monitor)
+    for t_s, yaw_deg in yaws:
+        alerts = monitor.update(sample(t_s, yaw_deg), speed_kmh)
+        yield FrameRecord(sample(t_s, yaw_deg), monitor.verdict, alerts)
+
+
+def glance(frames: int) -> list[tuple[float, float | None]]:
+    """1 s ahead, 4 s at 45 deg, then ahead, at 30 fps."""
+    return [(f / 30, 45.0 if 1.0 <= f / 30 < 5.0 else 0.0) for f in range(frames)]
+
+
+def test_publisher_sends_every_record_and_each_alert_in_order() -> None:
+    link = FakeLink()
+    publisher = BusPublisher("car-0", link, wall_clock=lambda: 1e9)
+    for record in records(FIXED, glance(300)):
+        publisher.on_record(record, BLANK_FRAME)
+    assert [m.seq for m in link.yaw] == list(range(300))
+    assert [(m.seq, m.kind, m.level) for m in link.alerts] == [
+        (0, "long_distraction", "warning"),
+        (1, "cleared", "info"),
+    ]
+    assert link.alerts[0].t_s == pytest.approx(4.0, abs=1 / 30)
+    assert link.alerts[1].clears == ["long_distraction"]
+    assert link.yaw[40].on_road is False and link.yaw[40].gaze == "off_road"
+    assert link.yaw[-1].on_road is True
+    jsonschema.validate(json.loads(link.yaw[0].to_json_bytes()), SCHEMAS["yaw"])
+    jsonschema.validate(json.loads(link.alerts[0].to_json_bytes()), SCHEMAS["alert"])
+
+
+def test_yaw_message_from_a_record_keeps_every_value() -> None:
+    record = list(records(FIXED, glance(40)))[-1]
+    message = YawMessage.from_record(record, "car-9", 7, 123.0)
+    assert (message.vehicle_id, message.seq, message.wall_time) == ("car-9", 7, 123.0)
+    assert (message.t_s, message.frame, message.face) == (39 / 30, 39, True)
+    assert (message.yaw_deg, message.gaze, message.on_road) == (45.0, "off_road", False)
+    assert json.loads(message.to_json_bytes())["gaze"] == "off_road"
+
+
+def test_verdict_text_for_the_annotated_video_names_gaze_time_and_alerts() -> None:
+    lines = [
+        verdict_text(record) for record in records(FIXED, [(f / 30, 45.0) for f in range(121)])
+    ]
+    assert lines[30] == "gaze off_road  off road 1.0 s  in window 1.0 s"
+    assert lines[90] == (
+        "gaze off_road  off road 3.0 s  in window 3.0 s  ALERT long_distraction:warning"
+    )
+
+
+def test_state_is_degraded_when_the_camera_or_zenoh_is_lost() -> None:
+    config = Config()
+    link = FakeLink()
+    health = Health(config, Keys.from_config(config.zenoh), link, "/dev/video0")
+    assert health.state_message().status == "starting"
+    health.on_record(next(records(config, [(0.0, 0.0)])), BLANK_FRAME)
+    assert (health.state_message().status, health.state_message().problems) == ("running", [])
+
+    class LostCamera:
+        status = SourceStatus(
+            connected=False, reopen_attempts=2, message="camera 0 lost; reconnecting"
+        )
+
+    health.source = LostCamera()  # type: ignore[assignment]
+    state = health.state_message()
+    assert state.status == "degraded"
+    assert state.problems == ["camera 0 lost; reconnecting"]
+    assert (state.source_status, state.camera_reopens) == ("reconnecting", 2)
+    health.source = None
+    link.connected = False
+    assert health.state_message().problems == ["zenoh not connected"]
+
+
+@pytest.mark.parametrize(
+    ("speed_payload", "expected"), [(b'{"kmh": 10}', 0), (b"50", 2), (None, 2)]
+)
+def test_alerts_are_gated_on_the_speed_received(speed_payload: bytes | None, expected: int) -> None:
+    speed = SpeedInput(stale_s=5.0)
+    if speed_payload is not None:
+        speed.on_payload(speed_payload)
+    link = FakeLink(speed=speed)
+    keys = Keys.from_config(FIXED.zenoh)
+    health = Health(FIXED, keys, link, "test")
+    yaws: list[float | None] = [45.0 if 1.0 <= f / 30 < 5.0 else 0.0 for f in range(180)]
+    pipeline = Pipeline.from_config(FIXED, ScriptedDetector(yaws), speed=speed.kmh)
+    pipeline.run(ListSource(len(yaws)), [health, BusPublisher(keys.vehicle_id, link)])
+    assert len(link.alerts) == expected
+    assert health.alerts_raised == expected
+    state = health.state_message()
+    assert state.monitor.speed_source == ("waiting" if speed_payload is None else "fresh")
+    assert state.monitor.moving is (expected > 0)

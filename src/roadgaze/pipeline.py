@@ -9,21 +9,23 @@ independent of each other and of their order.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
-from roadgaze.capture import FrameSource, SourceStatus
+from roadgaze.capture import FrameSource, ReadAhead, SourceStatus
 from roadgaze.config import Config
+from roadgaze.handoff import Handoff
 from roadgaze.monitor import Monitor
 from roadgaze.pose import PoseEstimator
-from roadgaze.types import Frame, FrameRecord, LandmarkDetector
+from roadgaze.types import Detection, Frame, FrameRecord, LandmarkDetector
 
 STAGES = ("decode", "landmarks", "geometry", "smoothing", "monitor", "sinks", "total")
 """Timed stages; `total` is one whole loop iteration, from asking for the frame to the last sink."""
@@ -91,6 +93,18 @@ class ProcessedFrame:
 
 
 @dataclass(frozen=True, slots=True)
+class _Detected:
+    """A frame after the landmark stage, on its way to the rest of the loop."""
+
+    frame: Frame
+    detection: Detection
+    decode_ms: float
+    landmarks_ms: float
+    received_s: float
+    """When the loop received the frame from its source (its `clock`, after pacing)."""
+
+
+@dataclass(frozen=True, slots=True)
 class StageStats:
     median_ms: float
     p99_ms: float
@@ -106,6 +120,10 @@ class StageTimings:
         self._times_ms: npt.NDArray[np.float64] = np.zeros((capacity, len(STAGES)))
         self._count = 0
         self._to_skip = skip_first
+
+    def skip_next(self, frames: int) -> None:
+        """Do not record the next `frames` frames (the start-up of another pass)."""
+        self._to_skip = frames
 
     def add(self, times: StageTimes) -> None:
         if self._to_skip > 0:
@@ -171,6 +189,7 @@ class Pipeline:
         self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
         self.speed = speed
         self._clock = clock
+        self._frame_received_s = math.nan
 
     @classmethod
     def from_config(
@@ -183,12 +202,28 @@ class Pipeline:
             speed=speed,
         )
 
+    @property
+    def frame_received_s(self) -> float:
+        """When the loop received the frame in hand from its source (the `clock`, seconds; after
+        pacing); sinks read it during `on_record`, e.g. to measure latency. NaN before a frame."""
+        return self._frame_received_s
+
     def process(self, frame: Frame, decode_ms: float = 0.0) -> ProcessedFrame:
         """One frame through every stage; frames must come in time order."""
-        clock = self._clock
-        start = clock()
+        return self._finish(self._detect(frame, decode_ms, self._clock()))
+
+    def _detect(self, frame: Frame, decode_ms: float, received_s: float) -> _Detected:
+        """The landmark stage of one frame (in the loop, on its own thread)."""
+        start = self._clock()
         detection = self.detector.detect(frame.image, frame.t_s)
-        after_landmarks = clock()
+        landmarks_ms = (self._clock() - start) * 1e3
+        return _Detected(frame, detection, decode_ms, landmarks_ms, received_s)
+
+    def _finish(self, detected: _Detected) -> ProcessedFrame:
+        """Pose, smoothing and monitor for a frame whose landmarks are known."""
+        clock = self._clock
+        frame, detection = detected.frame, detected.detection
+        start = clock()
         yaw_raw_deg = self.pose.raw_yaw_deg(detection.driver)
         after_geometry = clock()
         sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg)
@@ -197,13 +232,13 @@ class Pipeline:
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)
         after_monitor = clock()
         times = StageTimes(
-            decode_ms=decode_ms,
-            landmarks_ms=(after_landmarks - start) * 1e3,
-            geometry_ms=(after_geometry - after_landmarks) * 1e3,
+            decode_ms=detected.decode_ms,
+            landmarks_ms=detected.landmarks_ms,
+            geometry_ms=(after_geometry - start) * 1e3,
             smoothing_ms=(after_smoothing - after_geometry) * 1e3,
             monitor_ms=(after_monitor - after_smoothing) * 1e3,
             sinks_ms=0.0,
-            total_ms=decode_ms + (after_monitor - start) * 1e3,
+            total_ms=detected.decode_ms + detected.landmarks_ms + (after_monitor - start) * 1e3,
         )
         return ProcessedFrame(frame=frame, record=record, times=times)
 
@@ -214,9 +249,35 @@ class Pipeline:
         realtime: bool = False,
         max_frames: int | None = None,
         stop: StopSignal | None = None,
-    ) -> Iterator[ProcessedFrame]:
+    ) -> Generator[ProcessedFrame, None, None]:
         """The loop as an iterator. `realtime` paces a file source at its own timeline; `stop`
-        ends the loop before the next frame."""
+        ends the loop before the next frame.
+
+        Three threads overlap the work of consecutive frames: a file source is decoded a few
+        frames ahead (`roadgaze.capture.ReadAhead`; a camera grabs in its own thread), the
+        landmark stage runs in its own thread one frame ahead, and pose, smoothing and monitor
+        (and the caller's sinks) run on the caller's thread, in frame order.
+        """
+        with contextlib.ExitStack() as stack:
+            if not source.info.live:
+                source = stack.enter_context(ReadAhead(source, close_source=False))
+            detected = stack.enter_context(
+                Handoff(self._detected(source, realtime, max_frames, stop), "roadgaze-landmarks")
+            )
+            for item in detected:
+                if stop is not None and stop.is_set():
+                    return
+                self._frame_received_s = item.received_s
+                yield self._finish(item)
+
+    def _detected(
+        self,
+        source: FrameSource,
+        realtime: bool,
+        max_frames: int | None,
+        stop: StopSignal | None,
+    ) -> Iterator[_Detected]:
+        """Frames with their landmarks, in order: the landmark thread's part of the loop."""
         clock = self._clock
         iterator = iter(source)
         pace = realtime and not source.info.live
@@ -237,7 +298,7 @@ class Pipeline:
                 wait_s = wall_start + (frame.t_s - first_t_s) - clock()
                 if wait_s > 0:
                     time.sleep(wait_s)
-            yield self.process(frame, decode_ms)
+            yield self._detect(frame, decode_ms, clock())
             produced += 1
 
     def run(
@@ -265,27 +326,27 @@ class Pipeline:
             watcher.start()
         wall_start = clock()
         try:
-            for processed in self.frames(
-                source, realtime=realtime, max_frames=max_frames, stop=stop
-            ):
-                before_sinks = clock()
-                for sink in sinks:
-                    sink.on_record(processed.record, processed.frame)
-                sinks_ms = (clock() - before_sinks) * 1e3
-                times = processed.times
-                timings.add(
-                    StageTimes(
-                        decode_ms=times.decode_ms,
-                        landmarks_ms=times.landmarks_ms,
-                        geometry_ms=times.geometry_ms,
-                        smoothing_ms=times.smoothing_ms,
-                        monitor_ms=times.monitor_ms,
-                        sinks_ms=sinks_ms,
-                        total_ms=times.total_ms + sinks_ms,
+            frames_in = self.frames(source, realtime=realtime, max_frames=max_frames, stop=stop)
+            with contextlib.closing(frames_in) as loop:  # closed at once, even on an error
+                for processed in loop:
+                    before_sinks = clock()
+                    for sink in sinks:
+                        sink.on_record(processed.record, processed.frame)
+                    sinks_ms = (clock() - before_sinks) * 1e3
+                    times = processed.times
+                    timings.add(
+                        StageTimes(
+                            decode_ms=times.decode_ms,
+                            landmarks_ms=times.landmarks_ms,
+                            geometry_ms=times.geometry_ms,
+                            smoothing_ms=times.smoothing_ms,
+                            monitor_ms=times.monitor_ms,
+                            sinks_ms=sinks_ms,
+                            total_ms=times.total_ms + sinks_ms,
+                        )
                     )
-                )
-                frames += 1
-                with_face += processed.record.sample.face
+                    frames += 1
+                    with_face += processed.record.sample.face
         finally:
             done.set()
         return RunSummary(

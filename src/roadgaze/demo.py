@@ -95,6 +95,18 @@ def subscriber_config(config: Config, port: int) -> Config:
     return config.model_copy(update={"zenoh": zenoh})
 
 
+def wait_for_liveliness(session: Any, key: str, timeout_s: float) -> bool:
+    """True once a liveliness token matching `key` answers in `session`; False after
+    `timeout_s`."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        replies = session.liveliness().get(key, timeout=0.5)
+        if any(reply.ok is not None for reply in replies):
+            return True
+        time.sleep(0.05)
+    return False
+
+
 class AlertSubscriber:
     """A Zenoh subscriber to the alert key in its own session; appends each alert to a file.
 
@@ -139,13 +151,7 @@ class AlertSubscriber:
 
     def wait_for_publisher(self, timeout_s: float) -> bool:
         """True once the publisher's liveliness token is visible (routes are then in place)."""
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            replies = self._session.liveliness().get(self.keys.alive, timeout=0.5)
-            if any(reply.ok is not None for reply in replies):
-                return True
-            time.sleep(0.05)
-        return False
+        return wait_for_liveliness(self._session, self.keys.alive, timeout_s)
 
     def wait_for_count(self, count: int, timeout_s: float) -> bool:
         """True once `count` alerts have arrived; False after `timeout_s`."""

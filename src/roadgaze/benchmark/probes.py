@@ -1,0 +1,133 @@
+"""Pipeline sinks that measure: resident memory, throughput after warm-up, capture stamps."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import OrderedDict
+from collections.abc import Callable
+from pathlib import Path
+
+from roadgaze.types import Frame, FrameRecord
+
+
+def resident_mb() -> float:
+    """This process's resident memory (VmRSS) in MiB; NaN where /proc is not available."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return float("nan")
+
+
+def cpu_seconds() -> float:
+    """CPU time of this process, all threads (MediaPipe's, decoding, Zenoh's) together."""
+    return time.process_time()
+
+
+class MemoryProbe:
+    """Samples VmRSS about once a second; the baseline is taken after `settle_s` of running."""
+
+    def __init__(self, settle_s: float = 10.0) -> None:
+        self._settle_s = settle_s
+        self._start = time.monotonic()
+        self._next = self._start
+        self.baseline_mb: float | None = None
+        self.last_mb = resident_mb()
+        self.peak_mb = self.last_mb
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        now = time.monotonic()
+        if now < self._next:
+            return
+        self._next = now + 1.0
+        self.last_mb = resident_mb()
+        self.peak_mb = max(self.peak_mb, self.last_mb)
+        if self.baseline_mb is None and now - self._start >= self._settle_s:
+            self.baseline_mb = self.last_mb
+
+    def close(self) -> None:
+        self.last_mb = resident_mb()
+
+    @property
+    def growth_mb(self) -> float | None:
+        return None if self.baseline_mb is None else self.last_mb - self.baseline_mb
+
+
+class ThroughputProbe:
+    """Frames per second and CPU milliseconds per frame after the first `warmup` records.
+
+    The clock starts when record `warmup` (0-based) has been handed to the sinks and stops at the
+    last record, so model start-up is excluded and everything else (decoding, every stage, the
+    sinks before this one, the loop itself) is included.
+    """
+
+    def __init__(
+        self,
+        warmup: int,
+        clock: Callable[[], float] = time.perf_counter,
+        cpu_clock: Callable[[], float] = cpu_seconds,
+    ) -> None:
+        self._warmup = warmup
+        self._clock = clock
+        self._cpu_clock = cpu_clock
+        self._seen = 0
+        self._start: tuple[float, float] | None = None
+        self._last: tuple[float, float] | None = None
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self._seen += 1
+        if self._seen == self._warmup + 1:
+            self._start = (self._clock(), self._cpu_clock())
+        elif self._seen > self._warmup + 1:
+            self._last = (self._clock(), self._cpu_clock())
+
+    def close(self) -> None:
+        return None
+
+    @property
+    def frames(self) -> int:
+        """Frames timed: those after the first one past the warm-up."""
+        return max(0, self._seen - self._warmup - 1)
+
+    @property
+    def fps(self) -> float | None:
+        if self._start is None or self._last is None or self._last[0] <= self._start[0]:
+            return None
+        return self.frames / (self._last[0] - self._start[0])
+
+    @property
+    def cpu_ms_per_frame(self) -> float | None:
+        if self._start is None or self._last is None or self.frames == 0:
+            return None
+        return 1e3 * (self._last[1] - self._start[1]) / self.frames
+
+
+class CaptureStamps:
+    """Sink keeping, per frame index, when the loop received the frame (for latency).
+
+    `received_s` reads that time for the current frame (`Pipeline.frame_received_s`). The newest
+    `capacity` stamps are kept; `pop(index)` takes one out, thread-safe.
+    """
+
+    def __init__(self, received_s: Callable[[], float], capacity: int = 4096) -> None:
+        self._received_s = received_s
+        self._capacity = capacity
+        self._stamps: OrderedDict[int, float] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        stamp = self._received_s()
+        with self._lock:
+            self._stamps[record.frame] = stamp
+            while len(self._stamps) > self._capacity:
+                self._stamps.popitem(last=False)
+
+    def pop(self, index: int) -> float | None:
+        with self._lock:
+            return self._stamps.pop(index, None)
+
+    def close(self) -> None:
+        return None

@@ -9,6 +9,7 @@ from typing import Any
 
 from roadgaze.commands.options import common_options
 from roadgaze.config import Config
+from roadgaze.logs import log_written
 
 
 def register(subparsers: Any) -> None:
@@ -19,7 +20,8 @@ def register(subparsers: Any) -> None:
         description="Estimate yaw on every image listed in DATASET_DIR/ground_truth.csv "
         "(columns file,yaw_deg[,pitch_deg]; rows with |pitch_deg| = 90 are skipped) and print "
         "MAE, RMSE, median error and detection rate per model and for MediaPipe's own yaw, for "
-        "|yaw| <= 60 deg, for all rows, and per 15 deg bin.",
+        "|yaw| <= 60 deg, for all rows, and per 15 deg bin. The report goes to stdout, the "
+        "progress bar and the log to stderr.",
     )
     parser.add_argument("dataset", type=Path, metavar="DATASET_DIR")
     parser.add_argument("--report", type=Path, metavar="JSON", help="write all figures as JSON")
@@ -92,13 +94,13 @@ def run(args: argparse.Namespace, config: Config) -> int:
     print(format_report(report))
     if args.predictions is not None:
         write_predictions(args.predictions, estimates)
-        print(f"wrote {args.predictions}")
+        log_written(args.predictions)
     if args.report is not None:
         write_report(args.report, report)
-        print(f"wrote {args.report}")
+        log_written(args.report)
     if args.plot is not None:
         save_plot(args.plot, truths, estimates)
-        print(f"wrote {args.plot}")
+        log_written(args.plot)
     if args.compare_landmarks is not None:
         table = format_landmark_comparison(
             compare_landmark_choices(truths, estimates, CANDIDATE_CHOICES, constants)
@@ -107,5 +109,5 @@ def run(args: argparse.Namespace, config: Config) -> int:
         args.compare_landmarks.write_text(table + "\n", encoding="utf-8")
         print()
         print(table)
-        print(f"wrote {args.compare_landmarks}")
+        log_written(args.compare_landmarks)
     return 0

@@ -235,9 +235,9 @@ def run_demo(
     plot_path = out_dir / PLOT_NAME
     plot = YawPlot(
         plot_path,
-        title="roadgaze demo: synthetic drive (green band: road ahead)",
+        title="roadgaze demo: synthetic drive",
         truth=truth,
-        road_half_width_deg=config.monitor.road_half_width_deg,
+        monitor=config.monitor,
     )
     progress(f"running the service over {VIDEO_NAME}, Zenoh on tcp/127.0.0.1:{port}")
     with ExitStack() as stack:
@@ -253,7 +253,9 @@ def run_demo(
         if not subscriber.wait_for_publisher(SUBSCRIBER_WAIT_S):
             log.warning("the subscriber did not see the publisher within %.0f s", SUBSCRIBER_WAIT_S)
         frames_writer = stack.enter_context(JsonlWriter(out_dir / FRAMES_NAME))
-        annotated = stack.enter_context(AnnotatedVideoWriter(out_dir / ANNOTATED_NAME, fps))
+        annotated = stack.enter_context(
+            AnnotatedVideoWriter(out_dir / ANNOTATED_NAME, fps, monitor=config.monitor)
+        )
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, [*bus.sinks, plot, frames_writer, annotated])
         raised = bus.health.alerts_raised

@@ -116,7 +116,9 @@ class ReplayStats:
         return text
 
 
-def build_sinks(args: argparse.Namespace, info: SourceInfo, stack: ExitStack) -> list[Sink]:
+def build_sinks(
+    args: argparse.Namespace, info: SourceInfo, stack: ExitStack, config: Config
+) -> list[Sink]:
     """The writer sinks the options ask for, each registered on `stack` to be closed at the end."""
     from roadgaze.outputs import AnnotatedVideoWriter, CsvWriter, JsonlWriter, ProgressBar, YawPlot
 
@@ -126,9 +128,11 @@ def build_sinks(args: argparse.Namespace, info: SourceInfo, stack: ExitStack) ->
     if args.csv is not None:
         sinks.append(stack.enter_context(CsvWriter(args.csv)))
     if args.plot is not None:
-        sinks.append(stack.enter_context(YawPlot(args.plot, title=Path(info.name).name)))
+        title = Path(info.name).name
+        sinks.append(stack.enter_context(YawPlot(args.plot, title, monitor=config.monitor)))
     if args.annotate is not None:
-        sinks.append(stack.enter_context(AnnotatedVideoWriter(args.annotate, info.fps or 30.0)))
+        writer = AnnotatedVideoWriter(args.annotate, info.fps or 30.0, monitor=config.monitor)
+        sinks.append(stack.enter_context(writer))
     records_on_terminal = to_stdout and sys.stdout.isatty()
     if not args.no_progress and not records_on_terminal:  # the records show the progress there
         total = info.frame_count
@@ -178,7 +182,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
         detector = create_detector(config)
         stack.callback(detector.close)
         bus = stack.enter_context(bus_outputs(config, args.source, args.publish))
-        sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack)]
+        sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack, config)]
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
     report(args, summary, stats)

@@ -1,7 +1,14 @@
 """Outputs: the flat per-frame record and its writers (JSONL, CSV), the plot and annotated video."""
 
-from roadgaze.outputs.annotate import AnnotatedVideoWriter, annotate, verdict_text
-from roadgaze.outputs.plots import YawPlot
+from roadgaze.outputs.annotate import (
+    PANEL_LINES,
+    AlertBoard,
+    AnnotatedVideoWriter,
+    Banner,
+    annotate,
+    verdict_text,
+)
+from roadgaze.outputs.plots import SERIES, Series, YawPlot, label_rows
 from roadgaze.outputs.progress import ProgressBar
 from roadgaze.outputs.records import (
     RECORD_FIELDS,
@@ -15,13 +22,19 @@ from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
 
 __all__ = [
     "FOURCC_BY_SUFFIX",
+    "PANEL_LINES",
     "RECORD_FIELDS",
+    "SERIES",
+    "AlertBoard",
     "AnnotatedVideoWriter",
+    "Banner",
     "CsvWriter",
     "JsonlWriter",
     "ProgressBar",
+    "Series",
     "YawPlot",
     "annotate",
+    "label_rows",
     "open_for_writing",
     "open_video_writer",
     "record_fields",

@@ -5,6 +5,7 @@ from types import ModuleType
 from roadgaze.commands import (
     bench,
     demo,
+    doctor,
     estimate,
     evaluate,
     listen,
@@ -28,6 +29,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     model,
     schema,
     paper,
+    doctor,
 )
 """Each module has `register(subparsers)`, which adds its parser and sets `handler(args, config)`.
 Heavy imports (MediaPipe, Zenoh, OpenCV) happen inside the handlers, so `--help` is fast."""

@@ -12,6 +12,7 @@ identical numbers (tested).
 from __future__ import annotations
 
 import ctypes
+import functools
 import importlib
 from typing import Any
 
@@ -69,14 +70,17 @@ class _CResultReader:
         return faces
 
 
-_READER = _CResultReader.find()
+@functools.cache
+def _reader() -> _CResultReader | None:
+    """Found on first use: importing MediaPipe waits until a landmarker runs."""
+    return _CResultReader.find()
 
 
 def uses_c_results(landmarker: Any) -> bool:
     """True when `run_landmarker` reads this landmarker's results straight from the C library."""
     lib = getattr(landmarker, "_lib", None)
     return (
-        _READER is not None
+        _reader() is not None
         and getattr(landmarker, "_handle", None) is not None
         and hasattr(lib, "MpFaceLandmarkerDetectForVideo")
         and hasattr(lib, "MpFaceLandmarkerDetectImage")
@@ -93,8 +97,9 @@ def run_landmarker(
     increasing). `direct=False` forces the public API (tests compare the two). Errors are
     MediaPipe's own (ValueError, RuntimeError).
     """
-    if direct and _READER is not None and uses_c_results(landmarker):
-        return _run_direct(landmarker, image, timestamp_ms, _READER)
+    reader = _reader() if direct else None
+    if reader is not None and uses_c_results(landmarker):
+        return _run_direct(landmarker, image, timestamp_ms, reader)
     if timestamp_ms is None:
         result = landmarker.detect(image)
     else:

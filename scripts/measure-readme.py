@@ -2,12 +2,15 @@
 """Regenerate the README's measured figures and print them as one Markdown block.
 
     .venv/bin/python scripts/measure-readme.py [--work DIR] [--repeat N] [--no-eval]
+                                               [--soak SECONDS]
 
 Runs, with the `roadgaze` of the Python that runs this script:
 1. `roadgaze demo --out WORK/demo`, timed (the demo's own render/service/total split too);
 2. `roadgaze bench WORK/demo/drive.mp4 --json --repeat N --latency` on the demo's drive;
-3. `roadgaze eval ../shared/data/pointing04-dev --workers 2 --report ...` when the evaluation
-   data sits beside the checkout (skipped, and said so, otherwise).
+3. `roadgaze synth --measure` (yaw recovery on synthetic stills with exact truth);
+4. `roadgaze eval ../shared/data/pointing04-dev --workers 2 --report ...` when the evaluation
+   data sits beside the checkout (skipped, and said so, otherwise);
+5. with `--soak S`, `roadgaze bench WORK/demo/drive.mp4 --loop-seconds S --memory --no-raw`.
 
 The block names the machine (CPU, cores, memory, OS, Python, MediaPipe and OpenCV versions) and
 its load average before and after, because on a shared machine the speed figures move with it.
@@ -105,6 +108,19 @@ def bench(video: Path, repeat: int) -> dict[str, Any]:
     return result
 
 
+def synth_measure() -> list[tuple[str, float]]:
+    """(|yaw| range, Center-CE MAE) rows of `roadgaze synth --measure`."""
+    table = roadgaze("synth", "--measure").stdout
+    rows = re.findall(r"^\s*(\d+-\d+)\s+\d+\s+\d+\s+([\d.]+)", table, flags=re.MULTILINE)
+    return [(label, float(mae)) for label, mae in rows]
+
+
+def soak(video: Path, seconds: float) -> dict[str, Any]:
+    args = ["bench", str(video), "--json", "--loop-seconds", f"{seconds:g}", "--memory", "--no-raw"]
+    result: dict[str, Any] = json.loads(roadgaze(*args).stdout)
+    return result
+
+
 def evaluate(work: Path) -> dict[str, Any] | None:
     if not POINTING04.is_dir():
         say(f"{POINTING04} not found: no accuracy figures")
@@ -122,7 +138,9 @@ def markdown(
     loads: tuple[str, str],
     demo_run: dict[str, Any],
     bench_run: dict[str, Any],
+    synth_rows: list[tuple[str, float]],
     eval_run: dict[str, Any] | None,
+    soak_run: dict[str, Any] | None,
 ) -> str:
     stages = bench_run["stages"]
     raw = bench_run.get("raw_mediapipe") or {}
@@ -152,6 +170,21 @@ def markdown(
         f"received; target p99 <= landmark p99 + 2 ms = {latency.get('target_p99_ms')} ms) "
         "| same |",
     ]
+    if soak_run is not None:
+        memory = soak_run["memory"]
+        lines.append(
+            f"| resident memory over a {memory['wall_s']:.0f} s replay loop | grew "
+            f"{memory['rss_growth_mb']} MiB (baseline {memory['rss_baseline_mb']} MiB, end "
+            f"{memory['rss_end_mb']}, peak {memory['rss_peak_mb']}; {soak_run['frames']} frames) "
+            f"| `roadgaze bench drive.mp4 --loop-seconds {memory['wall_s']:.0f} --memory` |"
+        )
+    if synth_rows:
+        ranges = " / ".join(f"{mae:.1f}" for _, mae in synth_rows[:-1])
+        labels = " / ".join(label for label, _ in synth_rows[:-1])
+        lines.append(
+            f"| yaw recovery on synthetic stills | Center-CE MAE {ranges} deg for |yaw| in "
+            f"{labels} (all: {synth_rows[-1][1]:.1f}) | `roadgaze synth --measure` |"
+        )
     if eval_run is not None:
         lines += [
             "",
@@ -166,7 +199,7 @@ def markdown(
             bold = "**" if method == "center_ce" else ""
             lines.append(
                 f"| {label} | {bold}{stats['mae_deg']:.2f}{bold} | {stats['rmse_deg']:.2f} | "
-                f"{stats['median_deg']:.2f} | {100 * stats['detection_rate']:.1f}% |"
+                f"{stats['median_abs_error_deg']:.2f} | {100 * stats['detection_rate']:.1f}% |"
             )
     return "\n".join(lines)
 
@@ -176,16 +209,26 @@ def main() -> int:
     parser.add_argument("--work", type=Path, help="folder for the runs (default: a temporary one)")
     parser.add_argument("--repeat", type=int, default=3, help="bench passes (default 3)")
     parser.add_argument("--no-eval", action="store_true", help="skip the accuracy run")
+    parser.add_argument(
+        "--soak", type=float, default=0.0, metavar="S", help="also a memory run of S seconds"
+    )
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="roadgaze-measure-") as scratch:
         work = args.work or Path(scratch)
         work.mkdir(parents=True, exist_ok=True)
         before = load_average()
         demo_run = demo(work)
-        bench_run = bench(work / "demo" / "drive.mp4", args.repeat)
+        video = work / "demo" / "drive.mp4"
+        bench_run = bench(video, args.repeat)
+        synth_rows = synth_measure()
         eval_run = None if args.no_eval else evaluate(work)
+        soak_run = soak(video, args.soak) if args.soak else None
         after = load_average()
-        print(markdown(machine(), (before, after), demo_run, bench_run, eval_run))
+        (work / "measured.json").write_text(
+            json.dumps({"demo": demo_run, "bench": bench_run, "soak": soak_run}, indent=2) + "\n"
+        )
+        host = machine()
+        print(markdown(host, (before, after), demo_run, bench_run, synth_rows, eval_run, soak_run))
     return 0
 
 

@@ -130,3 +130,21 @@ def test_check_period_zero_always_runs_the_multi_face_landmarker(model_path: Pat
         assert detector._counter is None and detector._single_landmarker is None
         detection = detector.detect(scene(True), 0.0)
         assert len(detection.faces) == 2 and detector.face_mode is FaceMode.MULTI
+
+
+def test_a_face_that_moves_away_from_the_tracked_place_is_found_on_the_same_frame(
+    model_path: Path,
+) -> None:
+    """The one-face landmarker looks for the face where it was; when it is gone from there,
+    the same frame is searched again (as the multi-face landmarker's every-frame detector did)."""
+    face = cv2.cvtColor(skimage_data.astronaut()[20:260, 120:340], cv2.COLOR_RGB2BGR)
+    left = np.full((260, 700, 3), 255, np.uint8)
+    left[10:250, 0:220] = face
+    right = np.full((260, 700, 3), 255, np.uint8)
+    right[10:250, 470:690] = face
+    with MediaPipeLandmarker(LandmarksConfig(), model_path, video=True) as detector:
+        for index in range(5):
+            assert detector.detect(left, index / 10).driver is not None
+        moved = detector.detect(right, 0.5).driver
+        assert detector.face_mode is FaceMode.SINGLE
+    assert moved is not None and moved.box_px[0] > 400

@@ -229,13 +229,24 @@ class MediaPipeLandmarker(ClosesOnExit):
             switch.counted(t_s, counter.count(mp_image))
         if switch.mode is FaceMode.SINGLE:
             faces = self._run(self._single_landmarker, mp_image, shape, timestamp_ms)
+            if not faces and switch.previous_box is not None:
+                # Tracking was lost on this frame. MediaPipe would look for a face only on the
+                # next one; look again now (its detector runs once it tracks no face), as the
+                # multi-face landmarker, which detects on every frame, would have.
+                faces = self._run(self._single_landmarker, mp_image, shape, self._next_ms())
             box = faces[0].box_px if faces else None
             if not switch.jumped(t_s, box):
                 return faces
             switch.counted(t_s, counter.count(mp_image))
-            if switch.mode is FaceMode.SINGLE:
+            if not switch.multi:
                 return faces
+            return self._run(self._landmarker, mp_image, shape, self._next_ms())
         return self._run(self._landmarker, mp_image, shape, timestamp_ms)
+
+    def _next_ms(self) -> int:
+        """A further MediaPipe timestamp within the current frame (a second call on it)."""
+        self._last_ms += 1
+        return self._last_ms
 
     def _run(
         self,

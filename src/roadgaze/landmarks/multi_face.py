@@ -58,6 +58,11 @@ class MultiFaceSwitch:
     previous_box: Box | None = None
     """The driver's box on the previous frame (None: no face)."""
 
+    @property
+    def multi(self) -> bool:
+        """True while the multi-face landmarker runs."""
+        return self.mode is FaceMode.MULTI
+
     def check_due(self, t_s: float) -> bool:
         return self.mode is FaceMode.SINGLE and (
             self.next_check_t_s is None or t_s >= self.next_check_t_s

@@ -6,12 +6,7 @@ by `LandmarksConfig.driver` (see `roadgaze.landmarks.driver`).
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import sys
-import tempfile
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +22,7 @@ from roadgaze.landmarks.multi_face import (
     MultiFaceSwitch,
     detector_model_bytes,
 )
+from roadgaze.landmarks.native_log import filtered_native_stderr
 from roadgaze.landmarks.results import run_landmarker
 from roadgaze.types import ClosesOnExit, Detection, FaceFeatures
 
@@ -51,43 +47,6 @@ def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
     else:
         raise ValueError(f"expected a grayscale, BGR or BGRA image, found shape {array.shape}")
     return np.ascontiguousarray(rgb)
-
-
-_NATIVE_NOISE = (
-    "WARNING: Logging before InitGoogle()",
-    "INFO: Created TensorFlow Lite",
-    "INFO: [",
-    "W0000 ",
-    "I0000 ",
-)
-"""Start-up and shut-down lines of MediaPipe and LiteRT (its runtime) that say nothing to a user."""
-
-
-@contextlib.contextmanager
-def filtered_native_stderr() -> Iterator[None]:
-    """Drop MediaPipe's start-up log lines (written by C++ to fd 2); pass every other line on."""
-    try:
-        sys.stderr.flush()
-        saved = os.dup(2)
-    except (OSError, ValueError):
-        yield
-        return
-    with tempfile.TemporaryFile(mode="w+b") as capture:
-        os.dup2(capture.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            capture.seek(0)
-            kept = [
-                line
-                for line in capture.read().decode("utf-8", "replace").splitlines(keepends=True)
-                if not line.startswith(_NATIVE_NOISE)
-            ]
-            if kept:
-                sys.stderr.write("".join(kept))
-                sys.stderr.flush()
 
 
 class MediaPipeLandmarker(ClosesOnExit):
@@ -125,6 +84,8 @@ class MediaPipeLandmarker(ClosesOnExit):
         self._single_landmarker: Any = None
         self._counter: FaceCounter | None = None
         self._switch: MultiFaceSwitch | None = None
+        self._started: set[int] = set()
+        """Landmarkers (by id) that have run once."""
         switching = (
             video
             and landmarks_config.max_faces > 1
@@ -257,8 +218,14 @@ class MediaPipeLandmarker(ClosesOnExit):
     ) -> list[FaceFeatures]:
         height, width = shape[:2]
         scale = np.array([width, height, width], np.float32)
+        if id(landmarker) in self._started:
+            results = run_landmarker(landmarker, mp_image, timestamp_ms)
+        else:  # MediaPipe's first inference logs its set-up (tensor alignment) on fd 2
+            with filtered_native_stderr():
+                results = run_landmarker(landmarker, mp_image, timestamp_ms)
+            self._started.add(id(landmarker))
         faces: list[FaceFeatures] = []
-        for points, matrix in run_landmarker(landmarker, mp_image, timestamp_ms):
+        for points, matrix in results:
             try:
                 faces.append(
                     features_from_landmarks(points * scale, (width, height), matrix, self._choice)

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from roadgaze.landmarks.driver import DRIVER_MATCH_IOU, box_iou
+from roadgaze.landmarks.native_log import filtered_native_stderr
 
 log = logging.getLogger(__name__)
 
@@ -124,10 +125,16 @@ class FaceCounter:
             min_detection_confidence=min_confidence,
         )
         self._detector: Any = vision.FaceDetector.create_from_options(options)
+        self._started = False
 
     def count(self, image: Any) -> int:
         """Faces in the `mediapipe.Image` `image`."""
-        return len(self._detector.detect(image).detections)
+        if self._started:
+            return len(self._detector.detect(image).detections)
+        with filtered_native_stderr():  # MediaPipe's first inference logs its set-up on fd 2
+            result = self._detector.detect(image)
+        self._started = True
+        return len(result.detections)
 
     def close(self) -> None:
         if self._detector is not None:

@@ -1,5 +1,4 @@
-"""Steps of the loop in their own threads: order, bounds, errors and stopping (`roadgaze.handoff`,
-`roadgaze.capture.ReadAhead`)."""
+"""A step of the loop in its own thread: order, bounds, errors and stopping (`roadgaze.handoff`)."""
 
 from __future__ import annotations
 
@@ -9,8 +8,6 @@ from collections.abc import Iterator
 
 import pytest
 
-from fakes import ListSource
-from roadgaze.capture import ReadAhead
 from roadgaze.errors import SourceError
 from roadgaze.handoff import Handoff
 
@@ -76,37 +73,3 @@ def test_bad_depth_and_second_iteration_are_refused() -> None:
     assert list(handoff) == []
     with pytest.raises(RuntimeError, match="only once"):
         list(handoff)
-
-
-def test_read_ahead_delivers_every_frame_and_reports_the_wrapped_status() -> None:
-    source = ListSource(40)
-    with ReadAhead(source) as ahead:
-        assert ahead.info == source.info
-        frames = list(ahead)
-        assert [frame.index for frame in frames] == list(range(40))
-        assert ahead.status.frames_delivered == 40 and ahead.status.ended
-
-
-def test_read_ahead_counts_only_frames_handed_out() -> None:
-    with ReadAhead(ListSource(40), depth=2) as ahead:
-        iterator = iter(ahead)
-        next(iterator)
-        next(iterator)
-        time.sleep(0.2)
-        status = ahead.status
-    assert status.frames_delivered == 2 and not status.ended
-
-
-class ClosingSource(ListSource):
-    closed = False
-
-    def close(self) -> None:
-        self.closed = True
-
-
-@pytest.mark.parametrize("close_source", [True, False])
-def test_read_ahead_closes_the_wrapped_source_only_when_asked(close_source: bool) -> None:
-    source = ClosingSource(5)
-    with ReadAhead(source, close_source=close_source) as ahead:
-        list(ahead)
-    assert source.closed is close_source

@@ -15,12 +15,12 @@ import threading
 import time
 from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
 
-from roadgaze.capture import FrameSource, ReadAhead, SourceStatus
+from roadgaze.capture import FrameSource, SourceStatus
 from roadgaze.config import Config
 from roadgaze.handoff import Handoff
 from roadgaze.monitor import Monitor
@@ -30,6 +30,9 @@ from roadgaze.types import Detection, Frame, FrameRecord, LandmarkDetector
 STAGES = ("decode", "landmarks", "geometry", "smoothing", "monitor", "sinks", "total")
 """Timed stages; `total` is one whole loop iteration, from asking for the frame to the last sink."""
 
+READ_AHEAD_FRAMES = 2
+"""Frames a file source is decoded (and prepared) ahead of the loop: enough to hide decoding, few
+enough to keep memory flat."""
 STOP_GRACE_S = 1.0
 """After a stop is asked for, how long the frame in hand may take before a live source is closed
 (which unblocks a loop waiting for a lost camera)."""
@@ -90,6 +93,21 @@ class ProcessedFrame:
     record: FrameRecord
     times: StageTimes
     """Before the sinks ran, `sinks_ms` is 0 and `total_ms` ends after the monitor."""
+
+
+@dataclass(frozen=True, slots=True)
+class _Decoded:
+    """A frame from the source, with its image prepared for the detector when it could be."""
+
+    frame: Frame
+    prepared: Any = None
+    """What the detector's `prepare(image)` made of the image (None: not prepared)."""
+
+
+def _decoded(source: FrameSource, prepare: Callable[[Any], Any] | None) -> Iterator[_Decoded]:
+    """The decode thread's part of the loop: each frame, and its prepared image."""
+    for frame in source:
+        yield _Decoded(frame, None if prepare is None else prepare(frame.image))
 
 
 @dataclass(frozen=True, slots=True)
@@ -210,12 +228,20 @@ class Pipeline:
 
     def process(self, frame: Frame, decode_ms: float = 0.0) -> ProcessedFrame:
         """One frame through every stage; frames must come in time order."""
-        return self._finish(self._detect(frame, decode_ms, self._clock()))
+        return self._finish(self._detect(_Decoded(frame), decode_ms, self._clock()))
 
-    def _detect(self, frame: Frame, decode_ms: float, received_s: float) -> _Detected:
-        """The landmark stage of one frame (in the loop, on its own thread)."""
+    def _detect(self, decoded: _Decoded, decode_ms: float, received_s: float) -> _Detected:
+        """The landmark stage of one frame (with the image prepared beforehand when it was)."""
+        frame = decoded.frame
         start = self._clock()
-        detection = self.detector.detect(frame.image, frame.t_s)
+        prepared, detect_prepared = (
+            decoded.prepared,
+            getattr(self.detector, "detect_prepared", None),
+        )
+        if prepared is not None and detect_prepared is not None:
+            detection: Detection = detect_prepared(prepared, frame.t_s)
+        else:
+            detection = self.detector.detect(frame.image, frame.t_s)
         landmarks_ms = (self._clock() - start) * 1e3
         return _Detected(frame, detection, decode_ms, landmarks_ms, received_s)
 
@@ -253,53 +279,42 @@ class Pipeline:
         """The loop as an iterator. `realtime` paces a file source at its own timeline; `stop`
         ends the loop before the next frame.
 
-        Three threads overlap the work of consecutive frames: a file source is decoded a few
-        frames ahead (`roadgaze.capture.ReadAhead`; a camera grabs in its own thread), the
-        landmark stage runs in its own thread one frame ahead, and pose, smoothing and monitor
-        (and the caller's sinks) run on the caller's thread, in frame order.
+        A file source is decoded, and each image prepared for the detector (`prepare`: MediaPipe's
+        RGB copy), in a thread of its own up to `READ_AHEAD_FRAMES` frames ahead, while the
+        detector works on the frame in hand; a camera grabs in its own thread already. Everything
+        else runs on the caller's thread, in frame order, with no hand-over between the landmarks
+        and the record, so a frame's latency is its own work.
         """
-        with contextlib.ExitStack() as stack:
-            if not source.info.live:
-                source = stack.enter_context(ReadAhead(source, close_source=False))
-            detected = stack.enter_context(
-                Handoff(self._detected(source, realtime, max_frames, stop), "roadgaze-landmarks")
-            )
-            for item in detected:
-                if stop is not None and stop.is_set():
-                    return
-                self._frame_received_s = item.received_s
-                yield self._finish(item)
-
-    def _detected(
-        self,
-        source: FrameSource,
-        realtime: bool,
-        max_frames: int | None,
-        stop: StopSignal | None,
-    ) -> Iterator[_Detected]:
-        """Frames with their landmarks, in order: the landmark thread's part of the loop."""
         clock = self._clock
-        iterator = iter(source)
         pace = realtime and not source.info.live
         first_t_s: float | None = None
         wall_start = 0.0
         produced = 0
-        while max_frames is None or produced < max_frames:
-            if stop is not None and stop.is_set():
-                return
-            before = clock()
-            frame = next(iterator, None)
-            decode_ms = (clock() - before) * 1e3
-            if frame is None:
-                return
-            if pace:
-                if first_t_s is None:
-                    first_t_s, wall_start = frame.t_s, clock()
-                wait_s = wall_start + (frame.t_s - first_t_s) - clock()
-                if wait_s > 0:
-                    time.sleep(wait_s)
-            yield self._detect(frame, decode_ms, clock())
-            produced += 1
+        with contextlib.ExitStack() as stack:
+            items: Iterator[_Decoded]
+            if source.info.live:
+                items = (_Decoded(frame) for frame in source)
+            else:
+                prepare = getattr(self.detector, "prepare", None)
+                decoding = Handoff(_decoded(source, prepare), "roadgaze-decode", READ_AHEAD_FRAMES)
+                items = iter(stack.enter_context(decoding))
+            while max_frames is None or produced < max_frames:
+                if stop is not None and stop.is_set():
+                    return
+                before = clock()
+                item = next(items, None)
+                decode_ms = (clock() - before) * 1e3
+                if item is None:
+                    return
+                if pace:
+                    if first_t_s is None:
+                        first_t_s, wall_start = item.frame.t_s, clock()
+                    wait_s = wall_start + (item.frame.t_s - first_t_s) - clock()
+                    if wait_s > 0:
+                        time.sleep(wait_s)
+                self._frame_received_s = clock()
+                yield self._finish(self._detect(item, decode_ms, self._frame_received_s))
+                produced += 1
 
     def run(
         self,

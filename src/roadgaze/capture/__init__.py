@@ -10,16 +10,13 @@ from roadgaze.capture.base import (
 from roadgaze.capture.camera import CameraSource, camera_device
 from roadgaze.capture.files import IMAGE_SUFFIXES, ImageFolderSource, LoopingSource, VideoFileSource
 from roadgaze.capture.open import open_source
-from roadgaze.capture.readahead import READ_AHEAD_FRAMES, ReadAhead
 
 __all__ = [
     "IMAGE_SUFFIXES",
-    "READ_AHEAD_FRAMES",
     "CameraSource",
     "FrameSource",
     "ImageFolderSource",
     "LoopingSource",
-    "ReadAhead",
     "SourceInfo",
     "SourceStatus",
     "VideoCaptureLike",

@@ -7,6 +7,7 @@ by `LandmarksConfig.driver` (see `roadgaze.landmarks.driver`).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +48,15 @@ def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
     else:
         raise ValueError(f"expected a grayscale, BGR or BGRA image, found shape {array.shape}")
     return np.ascontiguousarray(rgb)
+
+
+@dataclass(frozen=True, slots=True)
+class PreparedImage:
+    """An image converted for MediaPipe (`MediaPipeLandmarker.prepare`)."""
+
+    rgb: npt.NDArray[np.uint8]
+    mp_image: Any
+    """The `mediapipe.Image` (MediaPipe's own copy of `rgb`)."""
 
 
 class MediaPipeLandmarker(ClosesOnExit):
@@ -140,6 +150,15 @@ class MediaPipeLandmarker(ClosesOnExit):
         """Which landmarker the stream runs now (MULTI when it never switches)."""
         return FaceMode.MULTI if self._switch is None else self._switch.mode
 
+    def prepare(self, image: npt.NDArray[np.uint8]) -> PreparedImage:
+        """The image as MediaPipe takes it (RGB, copied into a `mediapipe.Image`).
+
+        Keeps no state, so another thread may prepare the next frame while this landmarker works
+        (the loop's decode thread does). Raises ValueError for an image that is not uint8 2-D/3-D.
+        """
+        rgb = to_rgb(image)
+        return PreparedImage(rgb, self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb))
+
     def detect(self, image: npt.NDArray[np.uint8], t_s: float | None = None) -> Detection:
         """All faces in one BGR (or grayscale / BGRA) uint8 image and which one is the driver.
 
@@ -148,7 +167,13 @@ class MediaPipeLandmarker(ClosesOnExit):
         """
         if self._landmarker is None:
             raise ValueError("landmarker is closed")
-        rgb = to_rgb(image)
+        return self.detect_prepared(self.prepare(image), t_s)
+
+    def detect_prepared(self, prepared: PreparedImage, t_s: float | None = None) -> Detection:
+        """`detect` of an image `prepare` made; the same errors but the image's."""
+        if self._landmarker is None:
+            raise ValueError("landmarker is closed")
+        rgb, mp_image = prepared.rgb, prepared.mp_image
         timestamp_ms: int | None = None
         if self._video:
             if t_s is None:
@@ -162,7 +187,6 @@ class MediaPipeLandmarker(ClosesOnExit):
             self._last_t_s, self._last_ms = t_s, timestamp_ms
         elif t_s is not None:
             raise ValueError("IMAGE mode takes no timestamp; construct with video=True")
-        mp_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb)
         if self._switch is not None and t_s is not None:
             faces = self._run_switching(mp_image, rgb.shape, t_s, timestamp_ms)
         else:

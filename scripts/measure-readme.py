@@ -162,7 +162,8 @@ def markdown(
         f"{bench_run['overhead_ratio']:.3f}) | same |",
         f"| throughput | {bench_run['pipeline_fps']} fps; MediaPipe alone "
         f"{bench_run['raw_mediapipe_fps']} fps; ratio_to_raw {bench_run['ratio_to_raw']} (passes: "
-        f"{', '.join(map(str, raw.get('ratios', [])))}) | same |",
+        f"{', '.join(map(str, raw.get('ratios', [])))}); median_ratio_to_raw "
+        f"{raw.get('median_ratio_to_raw')} | same |",
         f"| CPU per frame | {bench_run['cpu_ms_per_frame']} ms (MediaPipe alone "
         f"{raw.get('cpu_ms_per_frame')} ms) | same |",
         f"| capture to Zenoh delivery | p50 {latency.get('p50_ms')} ms, p99 "
@@ -182,13 +183,13 @@ def markdown(
         ranges = " / ".join(f"{mae:.1f}" for _, mae in synth_rows[:-1])
         labels = " / ".join(label for label, _ in synth_rows[:-1])
         lines.append(
-            f"| yaw recovery on synthetic stills | Center-CE MAE {ranges} deg for |yaw| in "
+            f"| yaw recovery on synthetic stills | Center-CE MAE {ranges} deg for \\|yaw\\| in "
             f"{labels} (all: {synth_rows[-1][1]:.1f}) | `roadgaze synth --measure` |"
         )
     if eval_run is not None:
         lines += [
             "",
-            f"Accuracy on Pointing'04 subjects 1-10, |yaw| <= 60 (`roadgaze eval "
+            f"Accuracy on Pointing'04 subjects 1-10, \\|yaw\\| <= 60 (`roadgaze eval "
             f"../shared/data/pointing04-dev --workers 2`, {eval_run['wall_s']:.0f} s):",
             "",
             "| method | MAE (deg) | RMSE | median | face found |",

@@ -8,6 +8,8 @@ from collections import OrderedDict
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from roadgaze.types import Frame, FrameRecord
 
 
@@ -61,7 +63,8 @@ class ThroughputProbe:
 
     The clock starts when record `warmup` (0-based) has been handed to the sinks and stops at the
     last record, so model start-up is excluded and everything else (decoding, every stage, the
-    sinks before this one, the loop itself) is included.
+    sinks before this one, the loop itself) is included. The newest `capacity` intervals between
+    records are kept for `median_interval_ms`, which a shared machine's load spikes move less.
     """
 
     def __init__(
@@ -69,6 +72,7 @@ class ThroughputProbe:
         warmup: int,
         clock: Callable[[], float] = time.perf_counter,
         cpu_clock: Callable[[], float] = cpu_seconds,
+        capacity: int = 20_000,
     ) -> None:
         self._warmup = warmup
         self._clock = clock
@@ -76,13 +80,18 @@ class ThroughputProbe:
         self._seen = 0
         self._start: tuple[float, float] | None = None
         self._last: tuple[float, float] | None = None
+        self._intervals_s = np.zeros(capacity)
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         self._seen += 1
         if self._seen == self._warmup + 1:
             self._start = (self._clock(), self._cpu_clock())
         elif self._seen > self._warmup + 1:
-            self._last = (self._clock(), self._cpu_clock())
+            now = (self._clock(), self._cpu_clock())
+            previous = self._last or self._start
+            assert previous is not None
+            self._intervals_s[(self.frames - 1) % len(self._intervals_s)] = now[0] - previous[0]
+            self._last = now
 
     def close(self) -> None:
         return None
@@ -97,6 +106,12 @@ class ThroughputProbe:
         if self._start is None or self._last is None or self._last[0] <= self._start[0]:
             return None
         return self.frames / (self._last[0] - self._start[0])
+
+    @property
+    def median_interval_ms(self) -> float | None:
+        """Median time between two records after the warm-up, milliseconds."""
+        held = self._intervals_s[: min(self.frames, len(self._intervals_s))]
+        return float(np.median(held)) * 1e3 if len(held) else None
 
     @property
     def cpu_ms_per_frame(self) -> float | None:

@@ -115,6 +115,7 @@ class PassResult:
     fps: float | None
     """After the warm-up (`ThroughputProbe`)."""
     cpu_ms_per_frame: float | None
+    median_interval_ms: float | None
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
@@ -195,7 +196,9 @@ def pipeline_pass(
         received_s[0] = lambda: pipeline.frame_received_s
         log.info("pipeline pass over %s", args.source)
         summary = pipeline.run(source, [*sinks, throughput], timings=timings)
-    return PassResult(summary, throughput.fps, throughput.cpu_ms_per_frame)
+    return PassResult(
+        summary, throughput.fps, throughput.cpu_ms_per_frame, throughput.median_interval_ms
+    )
 
 
 def _round(value: float | None, digits: int) -> float | None:
@@ -218,6 +221,7 @@ def bench_result(
     overhead = total.median_ms / landmarks.median_ms if total and landmarks else math.nan
     pipeline_fps = _median([p.fps for p in passes])
     cpu_ms = _median([p.cpu_ms_per_frame for p in passes])
+    interval_ms = _median([p.median_interval_ms for p in passes])
     result: dict[str, Any] = {
         "source": source,
         "frames": frames,
@@ -254,6 +258,9 @@ def bench_result(
             "pipeline_passes_fps": [_round(p.fps, 2) for p in passes],
             "ratios": [round(ratio, 4) for ratio in ratios],
             "cpu_ratio_to_raw": None if not cpu_ms else round(raw.cpu_ms_per_frame / cpu_ms, 4),
+            "median_ratio_to_raw": None
+            if not interval_ms
+            else round(raw.percentile_ms(50) / interval_ms, 4),
         }
     if latency is not None:
         target_ms = None if landmarks is None else landmarks.p99_ms + LATENCY_MARGIN_MS
@@ -300,6 +307,7 @@ def format_result(result: dict[str, Any]) -> str:
             f"cpu ms/frame   {result['cpu_ms_per_frame']} (raw {raw['cpu_ms_per_frame']}; "
             f"cpu_ratio_to_raw {raw['cpu_ratio_to_raw']})"
         )
+        lines.append(f"median_ratio_to_raw {raw['median_ratio_to_raw']} (median frame times)")
     if "latency" in result:
         latency = result["latency"]
         lines.append(

@@ -9,8 +9,9 @@ can be measured the same way: MediaPipe's FaceLandmarker alone on the clip (VIDE
 frames decoded first, only `detect_for_video` timed), then the tree's `Pipeline.run` over the
 clip with no outputs (frames per second after a warm-up), then MediaPipe alone again; the ratio
 is the pipeline's fps over the mean of the two raw passes, the median ratio the raw passes'
-median call time over the pipeline's median time between frames (load spikes move it less). Every run is printed (a shared
-machine's load moves single runs), then the medians; progress on stderr, the table on stdout.
+median call time over the pipeline's median time between frames (load spikes move it less).
+Every run is printed (a shared machine's load moves single runs), then the medians; progress on
+stderr, the table on stdout.
 """
 
 from __future__ import annotations

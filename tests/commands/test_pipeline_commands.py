@@ -142,6 +142,10 @@ def test_bench_latency_through_a_loopback_subscriber(capsys: pytest.CaptureFixtu
     landmarks_p99 = result["stages"]["landmarks"]["p99_ms"]
     assert latency["target_p99_ms"] == pytest.approx(landmarks_p99 + 2.0, abs=1e-3)
     assert latency["meets_target"] == (latency["p99_ms"] <= latency["target_p99_ms"])
+    # The two parts: in the loop up to the publish (at least the landmark stage), then Zenoh.
+    assert 0 < latency["delivery_p50_ms"] < latency["p50_ms"]
+    assert latency["to_publish_p50_ms"] >= 0.5 * result["stages"]["landmarks"]["median_ms"]
+    assert latency["to_publish_p50_ms"] <= latency["p50_ms"]
 
 
 @pytest.mark.parametrize(

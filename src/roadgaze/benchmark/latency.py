@@ -35,11 +35,19 @@ MAX_SAMPLES = 100_000
 
 @dataclass(frozen=True, slots=True)
 class LatencyResult:
+    """Capture to delivery, and its two parts: in the loop up to the publish, then Zenoh."""
+
     published: int
     received: int
     p50_ms: float
     p99_ms: float
     max_ms: float
+    to_publish_p50_ms: float = float("nan")
+    """From the frame's receipt to its messages handed to Zenoh (landmarks, pose, monitor)."""
+    to_publish_p99_ms: float = float("nan")
+    delivery_p50_ms: float = float("nan")
+    """From the hand-over to Zenoh to the subscriber's callback (transport, callback thread)."""
+    delivery_p99_ms: float = float("nan")
 
 
 class YawLatencyProbe:
@@ -52,6 +60,7 @@ class YawLatencyProbe:
         self._stamps = stamps
         self._lock = threading.Lock()
         self._latencies_s: list[float] = []
+        self._parts_s: list[tuple[float, float]] = []
         self.received = 0
         self.undecodable = 0
         self._session: Any = None
@@ -71,13 +80,17 @@ class YawLatencyProbe:
             with self._lock:
                 self.undecodable += 1
             return
-        stamp = self._stamps.pop(frame)
+        stamps = self._stamps.pop(frame)
         with self._lock:
             self.received += 1
-            if stamp is not None:
+            if stamps is not None:
+                received_s, published_s = stamps
                 if len(self._latencies_s) >= MAX_SAMPLES:
                     del self._latencies_s[: MAX_SAMPLES // 10]
-                self._latencies_s.append(arrived - stamp)
+                    del self._parts_s[: MAX_SAMPLES // 10]
+                self._latencies_s.append(arrived - received_s)
+                if published_s is not None:
+                    self._parts_s.append((published_s - received_s, arrived - published_s))
 
     def wait_for_publisher(self, timeout_s: float) -> bool:
         """True once the publisher's liveliness token is visible (routes are then in place)."""
@@ -97,15 +110,22 @@ class YawLatencyProbe:
     def result(self, published: int) -> LatencyResult:
         with self._lock:
             milliseconds = 1e3 * np.asarray(self._latencies_s)
+            parts_ms = 1e3 * np.asarray(self._parts_s).reshape(-1, 2)
             received = self.received
         if milliseconds.size == 0:
             return LatencyResult(published, received, float("nan"), float("nan"), float("nan"))
+        to_publish = np.percentile(parts_ms[:, 0], [50, 99]) if len(parts_ms) else [np.nan] * 2
+        delivery = np.percentile(parts_ms[:, 1], [50, 99]) if len(parts_ms) else [np.nan] * 2
         return LatencyResult(
             published=published,
             received=received,
             p50_ms=float(np.median(milliseconds)),
             p99_ms=float(np.percentile(milliseconds, 99)),
             max_ms=float(np.max(milliseconds)),
+            to_publish_p50_ms=float(to_publish[0]),
+            to_publish_p99_ms=float(to_publish[1]),
+            delivery_p50_ms=float(delivery[0]),
+            delivery_p99_ms=float(delivery[1]),
         )
 
     def close(self) -> None:
@@ -144,6 +164,7 @@ def measure_latency(
         try:
             if not probe.wait_for_publisher(SUBSCRIBER_WAIT_S):
                 log.warning("the latency subscriber did not see the publisher in time")
-            yield LatencyRig(sinks=(stamps, *bus.sinks), probe=probe, stamps=stamps)
+            sinks = (stamps, *bus.sinks, stamps.published_mark)
+            yield LatencyRig(sinks=sinks, probe=probe, stamps=stamps)
         finally:
             probe.close()

@@ -121,28 +121,53 @@ class ThroughputProbe:
 
 
 class CaptureStamps:
-    """Sink keeping, per frame index, when the loop received the frame (for latency).
+    """Sink keeping, per frame index, when the loop received the frame and when its messages had
+    been published (for latency).
 
-    `received_s` reads that time for the current frame (`Pipeline.frame_received_s`). The newest
-    `capacity` stamps are kept; `pop(index)` takes one out, thread-safe.
+    `received_s` reads the first for the current frame (`Pipeline.frame_received_s`); put this
+    sink before the publisher and `published_mark` after it. The newest `capacity` frames are
+    kept; `pop(index)` takes one out as (received_s, published_s or None), thread-safe.
     """
 
     def __init__(self, received_s: Callable[[], float], capacity: int = 4096) -> None:
         self._received_s = received_s
         self._capacity = capacity
-        self._stamps: OrderedDict[int, float] = OrderedDict()
+        self._stamps: OrderedDict[int, list[float | None]] = OrderedDict()
         self._lock = threading.Lock()
+        self.published_mark = _PublishedMark(self)
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         stamp = self._received_s()
         with self._lock:
-            self._stamps[record.frame] = stamp
+            self._stamps[record.frame] = [stamp, None]
             while len(self._stamps) > self._capacity:
                 self._stamps.popitem(last=False)
 
-    def pop(self, index: int) -> float | None:
+    def _published(self, index: int, now_s: float) -> None:
         with self._lock:
-            return self._stamps.pop(index, None)
+            entry = self._stamps.get(index)
+            if entry is not None:
+                entry[1] = now_s
+
+    def pop(self, index: int) -> tuple[float, float | None] | None:
+        with self._lock:
+            entry = self._stamps.pop(index, None)
+        if entry is None or entry[0] is None:
+            return None
+        return entry[0], entry[1]
+
+    def close(self) -> None:
+        return None
+
+
+class _PublishedMark:
+    """The sink after the publisher: stamps when a frame's messages were handed to Zenoh."""
+
+    def __init__(self, stamps: CaptureStamps) -> None:
+        self._stamps = stamps
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self._stamps._published(record.frame, time.perf_counter())
 
     def close(self) -> None:
         return None

@@ -202,7 +202,8 @@ def pipeline_pass(
 
 
 def _round(value: float | None, digits: int) -> float | None:
-    return None if value is None else round(value, digits)
+    """`value` rounded; None (JSON null) for None, NaN or infinity."""
+    return None if value is None or not math.isfinite(value) else round(value, digits)
 
 
 def bench_result(
@@ -270,6 +271,10 @@ def bench_result(
             "p50_ms": _round(latency.p50_ms, 3),
             "p99_ms": _round(latency.p99_ms, 3),
             "max_ms": _round(latency.max_ms, 3),
+            "to_publish_p50_ms": _round(latency.to_publish_p50_ms, 3),
+            "to_publish_p99_ms": _round(latency.to_publish_p99_ms, 3),
+            "delivery_p50_ms": _round(latency.delivery_p50_ms, 3),
+            "delivery_p99_ms": _round(latency.delivery_p99_ms, 3),
             "target_p99_ms": _round(target_ms, 3),
             "meets_target": None if target_ms is None else bool(latency.p99_ms <= target_ms),
         }
@@ -315,6 +320,11 @@ def format_result(result: dict[str, Any]) -> str:
             f"{latency['max_ms']} ms ({latency['received']} of {latency['published']} received; "
             f"target p99 <= {latency['target_p99_ms']} ms: "
             f"{'met' if latency['meets_target'] else 'not met'})"
+        )
+        lines.append(
+            f"  of which   to publish p50 {latency['to_publish_p50_ms']} / p99 "
+            f"{latency['to_publish_p99_ms']} ms, Zenoh delivery p50 {latency['delivery_p50_ms']} / "
+            f"p99 {latency['delivery_p99_ms']} ms"
         )
     if "memory" in result:
         memory = result["memory"]

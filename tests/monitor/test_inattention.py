@@ -30,7 +30,9 @@ YawAt = Callable[[float], float | None]
 """Yaw at time t, None for no face."""
 
 
-def sample(t_s: float, yaw_deg: float | None, frame: int = 0) -> PoseSample:
+def sample(
+    t_s: float, yaw_deg: float | None, frame: int = 0, pitch_deg: float | None = None
+) -> PoseSample:
     face = yaw_deg is not None
     return PoseSample(
         t_s=t_s,
@@ -41,6 +43,8 @@ def sample(t_s: float, yaw_deg: float | None, frame: int = 0) -> PoseSample:
         yaw_rate_dps=0.0 if face else None,
         yaw_std_deg=1.0 if face else None,
         n_faces=int(face),
+        pitch_raw_deg=pitch_deg if face else None,
+        pitch_deg=pitch_deg if face else None,
     )
 
 
@@ -58,8 +62,13 @@ def run(
     return monitor, alerts
 
 
+AWAY_YAW_DEG = -30.0
+"""A glance to the driver's right, short of the right mirror: zone `away` (not driving-related).
+(Before zones the timing tests glanced to +45 deg, which the default zones call `left_mirror`.)"""
+
+
 def glances(
-    starts_s: list[float], length_s: float, yaw_deg: float = 45.0, base_deg: float = 0.0
+    starts_s: list[float], length_s: float, yaw_deg: float = AWAY_YAW_DEG, base_deg: float = 0.0
 ) -> YawAt:
     def yaw_at(t_s: float) -> float:
         inside = any(start <= t_s + 1e-9 < start + length_s for start in starts_s)
@@ -81,7 +90,7 @@ def test_long_distraction_fires_three_seconds_into_a_glance_then_clears() -> Non
     assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
     assert_within_one_frame(alerts[0].t_s, 7.0)
     assert alerts[0].off_road_s == pytest.approx(3.0, abs=FRAME_S)
-    assert alerts[0].yaw_deg == 45.0
+    assert alerts[0].yaw_deg == AWAY_YAW_DEG
     assert_within_one_frame(alerts[1].t_s, 8.0)
     assert alerts[1].clears == (AlertKind.LONG_DISTRACTION,)
     assert alerts[1].off_road_s == pytest.approx(4.0, abs=FRAME_S)
@@ -129,7 +138,7 @@ def test_yaw_flickering_around_the_limit_does_not_restart_the_episode() -> None:
     def yaw_at(t_s: float) -> float:
         if t_s < 1.0:
             return 0.0
-        return 26.0 if int(t_s * FPS) % 2 else 23.0  # inside the hysteresis band once off road
+        return -26.0 if int(t_s * FPS) % 2 else -23.0  # inside the hysteresis band once off road
 
     _, alerts = run(yaw_at, 4.5)
     assert kinds(alerts) == [("long_distraction", "warning")]
@@ -220,7 +229,8 @@ def test_face_lost_after_a_turn_is_off_road_not_unavailable() -> None:
             return None  # profile: the landmarker loses the face
         return 0.0
 
-    monitor, alerts = run(yaw_at, 8.0)
+    no_mirrors = FIXED.model_copy(update={"driving_related_zones": []})  # the turn crosses one
+    monitor, alerts = run(yaw_at, 8.0, no_mirrors)
     assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
     first_off = next(k / FPS for k in range(300) if (yaw_at(k / FPS) or 0.0) > 25.0)
     assert_within_one_frame(alerts[0].t_s, first_off + 3.0)

@@ -200,7 +200,7 @@ def run_demo(
     """
     from roadgaze.capture import open_source
     from roadgaze.daemon import bus_outputs
-    from roadgaze.outputs import AnnotatedVideoWriter, JsonlWriter, YawPlot
+    from roadgaze.outputs import AnnotatedVideoWriter, JsonlWriter, YawPlot, fill_offline_columns
     from roadgaze.pipeline import Pipeline, create_detector
     from roadgaze.synth import FaceRenderer, load_photo, render_clip
 
@@ -254,6 +254,7 @@ def run_demo(
         if not subscriber.wait_for_count(raised, SUBSCRIBER_WAIT_S):
             log.warning("the subscriber received %d of %d alerts", len(subscriber.received), raised)
         received = tuple(subscriber.received)
+    fill_offline_columns(out_dir / FRAMES_NAME, config.smoothing)
     served = time.perf_counter()
 
     smoothed = np.asarray(plot.smoothed_deg)

@@ -328,3 +328,142 @@ def test_monitor_imports_no_heavy_modules() -> None:
         [sys.executable, "-c", code], capture_output=True, timeout=60, env=env, check=False
     )
     assert result.returncode == 0, result.stderr
+
+
+# Zones: mirrors are driving-related (off road, counted for VATS, no long distraction alone).
+
+Pose = tuple[float, float] | None
+"""(yaw, pitch) at a time; None for no face."""
+
+
+def run_poses(
+    pose_at: Callable[[float], Pose], duration_s: float, config: MonitorConfig = FIXED
+) -> tuple[Monitor, list[Alert], list[str | None]]:
+    monitor = Monitor(config)
+    alerts: list[Alert] = []
+    zones: list[str | None] = []
+    for frame in range(round(duration_s * FPS)):
+        t_s = frame / FPS
+        pose = pose_at(t_s)
+        yaw, pitch = (None, None) if pose is None else pose
+        alerts.extend(monitor.update(sample(t_s, yaw, frame, pitch)))
+        zones.append(monitor.verdict.zone)
+    return monitor, alerts, zones
+
+
+def segments(*parts: tuple[float, Pose]) -> Callable[[float], Pose]:
+    """Consecutive (seconds, pose) parts; the last pose holds afterwards."""
+
+    def pose_at(t_s: float) -> Pose:
+        start = 0.0
+        for length_s, pose in parts:
+            if t_s + 1e-9 < start + length_s:
+                return pose
+            start += length_s
+        return parts[-1][1]
+
+    return pose_at
+
+
+ROAD_POSE = (0.0, 0.0)
+LEFT_MIRROR = (45.0, 0.0)
+RIGHT_MIRROR = (-60.0, 0.0)
+AWAY_POSE = (AWAY_YAW_DEG, 0.0)
+LAP = (0.0, -35.0)
+
+
+def test_a_long_mirror_glance_is_off_road_but_raises_no_long_distraction() -> None:
+    _, alerts, zones = run_poses(
+        segments((1.0, ROAD_POSE), (8.0, LEFT_MIRROR), (2.0, ROAD_POSE)), 11.0
+    )
+    assert alerts == []
+    assert zones[60] == "left_mirror" and zones[-1] == "road"
+    inside = Monitor(FIXED)
+    for frame in range(round(5.0 * FPS)):
+        inside.update(sample(frame / FPS, 0.0 if frame < 30 else 45.0, frame, 0.0))
+    verdict = inside.verdict
+    assert (verdict.zone, verdict.on_road, verdict.gaze) == ("left_mirror", False, Gaze.OFF_ROAD)
+    assert verdict.off_road_s == pytest.approx(4.0 - FRAME_S, abs=1e-6)
+    assert verdict.window_off_road_s == pytest.approx(4.0 - FRAME_S, abs=1e-6)
+    assert verdict.distraction_s == 0.0
+
+
+def test_mirror_glances_count_for_vats() -> None:
+    parts: list[tuple[float, Pose]] = [(1.0, ROAD_POSE)]
+    for mirror in (LEFT_MIRROR, RIGHT_MIRROR) * 3:
+        parts += [(2.5, mirror), (1.0, ROAD_POSE)]
+    _, alerts, _ = run_poses(segments(*parts), 22.0)
+    assert kinds(alerts) == [("vats", "warning"), ("cleared", "info")]
+    assert_within_one_frame(alerts[0].t_s, 1.0 + 3 * 3.5 + 2.5)  # the fourth glance ends at 10 s
+
+
+@pytest.mark.parametrize(
+    ("parts", "expected_s"),
+    [
+        # mirror 1 s, then away: the timer starts with the away part and fires 3 s into it
+        (((1.0, ROAD_POSE), (1.0, LEFT_MIRROR), (5.0, AWAY_POSE)), 1.0 + 1.0 + 3.0),
+        # away 2 s, mirror 2 s (pauses, does not reset), away again: 1 s more
+        (((1.0, ROAD_POSE), (2.0, AWAY_POSE), (2.0, RIGHT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 5.0),
+        # mirror 1.5 s then away 2 s: 2 s of distraction, no alert
+        (((1.0, ROAD_POSE), (1.5, LEFT_MIRROR), (2.0, AWAY_POSE), (2.0, ROAD_POSE)), None),
+        # the lap is not driving-related
+        (((1.0, ROAD_POSE), (4.0, LAP), (1.0, ROAD_POSE)), 1.0 + 3.0),
+    ],
+)
+def test_mirror_time_pauses_the_long_distraction_timer(
+    parts: tuple[tuple[float, Pose], ...], expected_s: float | None
+) -> None:
+    total_s = sum(length for length, _ in parts) + 1.0
+    _, alerts, _ = run_poses(segments(*parts), total_s)
+    long_alerts = [a for a in alerts if a.label == "long_distraction:warning"]
+    if expected_s is None:
+        assert long_alerts == []
+    else:
+        assert len(long_alerts) == 1
+        assert_within_one_frame(long_alerts[0].t_s, expected_s)
+        assert long_alerts[0].off_road_s == pytest.approx(expected_s - 1.0, abs=FRAME_S)
+
+
+def test_a_mirror_stay_longer_than_the_limit_counts_from_its_start() -> None:
+    config = FIXED.model_copy(update={"driving_glance_max_s": 2.0})
+    _, alerts, _ = run_poses(
+        segments((1.0, ROAD_POSE), (5.0, LEFT_MIRROR), (1.0, ROAD_POSE)), 7.0, config
+    )
+    assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
+    assert_within_one_frame(alerts[0].t_s, 1.0 + 3.0)
+    _, short, _ = run_poses(
+        segments((1.0, ROAD_POSE), (1.9, LEFT_MIRROR), (2.0, AWAY_POSE), (1.0, ROAD_POSE)),
+        6.0,
+        config,
+    )
+    assert short == []  # 1.9 s of mirror is a glance; 2 s away is not yet a long distraction
+
+
+def test_a_face_lost_in_a_mirror_glance_counts_as_away() -> None:
+    _, alerts, zones = run_poses(
+        segments((1.0, ROAD_POSE), (1.0, LEFT_MIRROR), (4.0, None), (1.0, ROAD_POSE)), 7.0
+    )
+    assert zones[45] == "left_mirror" and zones[75] == "away"
+    assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
+    assert_within_one_frame(alerts[0].t_s, 2.0 + 3.0)  # from the loss: out of view is not a mirror
+
+
+def test_pitch_neutral_is_learned_and_looking_down_is_the_lap() -> None:
+    config = MonitorConfig(neutral_yaw_deg=0.0)  # pitch neutral learned
+    camera_low = 12.0  # the road-ahead pose seen from a camera below the line of sight
+    monitor, alerts, zones = run_poses(lambda t: (0.0, camera_low), 120.0, config)
+    assert alerts == []
+    assert monitor.state.neutral_pitch_deg == pytest.approx(
+        camera_low * (1 - 2.718281828**-2), abs=0.05
+    )
+    neutral = monitor.state.neutral_pitch_deg
+    monitor.update(sample(120.0, 0.0, 0, neutral - 19.0))
+    assert monitor.verdict.zone == "lap"  # 19 deg below the neutral, 7 deg below the camera axis
+    fixed = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=-5.0)
+    monitor, _, zones = run_poses(lambda t: (0.0, -25.0), 2.0, fixed)
+    assert monitor.state.neutral_pitch_deg == -5.0 and zones[-1] == "lap"
+
+
+def test_a_sample_without_pitch_is_judged_at_level_pitch() -> None:
+    _, _, zones = run_poses(lambda t: None if t < 0 else (0.0, float("nan")), 1.0)
+    assert zones[-1] == "road"

@@ -271,18 +271,30 @@ def test_explicit_turn_away_angle() -> None:
     assert_within_one_frame(alerts[0].t_s, 3.5)
 
 
-def test_neutral_is_learned_slowly_from_on_road_samples() -> None:
+def test_neutral_settles_on_the_road_pose_then_follows_it_slowly() -> None:
+    """A running mean at first (the road pose within a second), then the 60 s filter.
+
+    (Before pitch, the neutral followed the 60 s filter from the start: 15.6 deg after 120 s at
+    18 deg; a neutral that takes minutes to settle put the matrix pitch's down gain and the
+    lap limit at the camera's axis instead of the driver's road pose for the whole first minute.)
+    """
     config = MonitorConfig()  # learning on, time constant 60 s
-    monitor, alerts = run(lambda t: 18.0, 120.0, config)
+    monitor, alerts = run(lambda t: 18.0, 1.0, config)
     assert alerts == []
-    # After two time constants the neutral has moved 1 - e^-2 of the way.
-    assert monitor.state.neutral_yaw_deg == pytest.approx(18.0 * (1 - 2.718281828**-2), abs=0.05)
-    monitor.update(sample(120.0, 18.0 + 24.0))  # 24 deg from neutral would be off road at 0
-    assert monitor.state.on_road is False  # 42 - 15.6 = 26.4 > 25
-    monitor.update(sample(121.0, 37.0))
-    assert monitor.state.on_road is False  # 37 - 15.6 = 21.4: inside the hysteresis band
-    monitor.update(sample(122.0, 35.0))
-    assert monitor.state.on_road is True  # 35 - 15.6 = 19.4 <= 20
+    assert monitor.state.neutral_yaw_deg == pytest.approx(18.0)
+    for frame in range(30, round(120 * FPS)):
+        monitor.update(sample(frame / FPS, 18.0))
+    for frame in range(round(120 * FPS), round(180 * FPS)):
+        monitor.update(sample(frame / FPS, 8.0))  # the road pose moves by 10 deg
+    # 120 s learned: the running mean's gain is below the filter's, which moves 1 - e^-1 in 60 s.
+    assert monitor.state.neutral_yaw_deg == pytest.approx(8.0 + 10.0 * 2.718281828**-1, abs=0.1)
+    neutral = monitor.state.neutral_yaw_deg
+    monitor.update(sample(180.0, neutral + 26.0))  # 26 deg from the neutral: off road
+    assert monitor.state.on_road is False
+    monitor.update(sample(181.0, neutral + 21.4))
+    assert monitor.state.on_road is False  # inside the hysteresis band
+    monitor.update(sample(182.0, neutral + 19.4))
+    assert monitor.state.on_road is True  # back within 20
 
 
 def test_neutral_is_clamped_and_fixed_neutral_is_used_as_is() -> None:
@@ -451,13 +463,11 @@ def test_a_face_lost_in_a_mirror_glance_counts_as_away() -> None:
 def test_pitch_neutral_is_learned_and_looking_down_is_the_lap() -> None:
     config = MonitorConfig(neutral_yaw_deg=0.0)  # pitch neutral learned
     camera_low = 12.0  # the road-ahead pose seen from a camera below the line of sight
-    monitor, alerts, zones = run_poses(lambda t: (0.0, camera_low), 120.0, config)
-    assert alerts == []
-    assert monitor.state.neutral_pitch_deg == pytest.approx(
-        camera_low * (1 - 2.718281828**-2), abs=0.05
-    )
+    monitor, alerts, zones = run_poses(lambda t: (0.0, camera_low), 3.0, config)
+    assert alerts == [] and set(zones) == {"road"}
+    assert monitor.state.neutral_pitch_deg == pytest.approx(camera_low)
     neutral = monitor.state.neutral_pitch_deg
-    monitor.update(sample(120.0, 0.0, 0, neutral - 19.0))
+    monitor.update(sample(3.0, 0.0, 0, neutral - 19.0))
     assert monitor.verdict.zone == "lap"  # 19 deg below the neutral, 7 deg below the camera axis
     fixed = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=-5.0)
     monitor, _, zones = run_poses(lambda t: (0.0, -25.0), 2.0, fixed)

@@ -10,9 +10,9 @@ Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monit
 - zone: each sample with a face gets a glance zone from its yaw and pitch relative to the neutral
   pose (`roadgaze.monitor.zones`: ordered rectangles, first match wins, else `away`, with
   hysteresis). `road` is on road; every other zone is off road. `neutral` (yaw and pitch) is
-  fixed by `neutral_yaw_deg` / `neutral_pitch_deg` or learned slowly (time constant
-  `neutral_time_constant_s`, clamped to +-`neutral_limit_deg` / `neutral_pitch_limit_deg`) from
-  road samples.
+  fixed by `neutral_yaw_deg` / `neutral_pitch_deg` or learned from road samples: a running mean
+  at first, then a first-order filter of time constant `neutral_time_constant_s`, clamped to
+  +-`neutral_limit_deg` / `neutral_pitch_limit_deg`.
 - face lost: while the head was off road (or, with `turn_away_deg` set, past that yaw), the
   driver is taken as still turned away, i.e. off road (zone: the last zone, `away` if that was
   driving-related); otherwise where they look is unknown (zone None) and, after
@@ -105,27 +105,34 @@ def _classify(
     return _Look(Gaze.OFF_ROAD, zone, zone, None, None, lost_since, True)
 
 
-def _learn(value: float | None, neutral: float, gain: float, limit: float) -> float:
-    if value is None:
-        return neutral
+def _learn(value: float, neutral: float, gain: float, limit: float) -> float:
     return max(-limit, min(limit, neutral + gain * (value - neutral)))
 
 
 def _learn_neutral(
     config: MonitorConfig, state: MonitorState, look: _Look, t_s: float
-) -> tuple[float, float]:
-    """The neutral yaw and pitch after this sample (learned from road samples only)."""
+) -> tuple[float, float, float, float]:
+    """The neutral yaw and pitch after this sample and the road time each has learned from.
+
+    Only road samples teach. The gain is the larger of the first-order filter's (time constant
+    `neutral_time_constant_s`) and a running mean's (dt over the time learned so far), so the
+    neutral settles on the driver's road pose within seconds of the start and then follows it
+    slowly.
+    """
+    yaw, pitch = state.neutral_yaw_deg, state.neutral_pitch_deg
+    yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s
     if look.gaze is not Gaze.ON_ROAD or look.yaw_deg is None or state.t_s is None:
-        return state.neutral_yaw_deg, state.neutral_pitch_deg
+        return yaw, pitch, yaw_s, pitch_s
     dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
-    gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)
-    yaw = state.neutral_yaw_deg
+    slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)
     if config.neutral_yaw_deg is None:
-        yaw = _learn(look.yaw_deg, yaw, gain, config.neutral_limit_deg)
-    pitch = state.neutral_pitch_deg
-    if config.neutral_pitch_deg is None:
+        gain = max(slow_gain, dt_s / (yaw_s + dt_s))
+        yaw, yaw_s = _learn(look.yaw_deg, yaw, gain, config.neutral_limit_deg), yaw_s + dt_s
+    if config.neutral_pitch_deg is None and look.pitch_deg is not None:
+        gain = max(slow_gain, dt_s / (pitch_s + dt_s))
         pitch = _learn(look.pitch_deg, pitch, gain, config.neutral_pitch_limit_deg)
-    return yaw, pitch
+        pitch_s += dt_s
+    return yaw, pitch, yaw_s, pitch_s
 
 
 def _count(counts: tuple[tuple[str, int], ...], alerts: list[Alert]) -> tuple[tuple[str, int], ...]:
@@ -254,11 +261,15 @@ def step(
         if raised.kind is not AlertKind.CLEARED and raised.kind not in active:
             active.append(raised.kind)
 
-    neutral_yaw, neutral_pitch = _learn_neutral(config, state, look, t_s)
+    neutral_yaw, neutral_pitch, yaw_learned_s, pitch_learned_s = _learn_neutral(
+        config, state, look, t_s
+    )
     new_state = replace(
         state,
         neutral_yaw_deg=neutral_yaw,
         neutral_pitch_deg=neutral_pitch,
+        neutral_yaw_learned_s=yaw_learned_s,
+        neutral_pitch_learned_s=pitch_learned_s,
         t_s=t_s,
         gaze=gaze,
         zone=look.zone,

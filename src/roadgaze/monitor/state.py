@@ -27,6 +27,9 @@ class MonitorState:
 
     neutral_yaw_deg: float
     neutral_pitch_deg: float = 0.0
+    neutral_yaw_learned_s: float = 0.0
+    """Road time the neutral yaw has learned from (its running mean's weight)."""
+    neutral_pitch_learned_s: float = 0.0
     t_s: float | None = None
     """Timestamp of the last sample taken into account."""
     gaze: Gaze = Gaze.ON_ROAD

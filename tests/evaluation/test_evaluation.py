@@ -197,14 +197,9 @@ def test_outputs_predictions_report_plot(tmp_path: Path) -> None:
         rows = list(csv.reader(stream))
     assert tuple(rows[0]) == PREDICTION_COLUMNS
     # the service's yaw falls back to Center-CE where it was not computed
-    assert rows[1] == ["a", "1", "2.000", "3.000", "4.000", "5.000", "6.000", "0.000", "5.000"] + [
-        "",
-        "0.000",
-        "",
-        "",
-        "",
-    ]
-    assert rows[3] == ["c", "0"] + [""] * (len(PREDICTION_COLUMNS) - 2)
+    yaws = ["2.000", "3.000", "4.000", "5.000", "6.000", "0.000", "5.000"]
+    assert rows[1] == ["a", "1", *yaws, "", "0.000", "", "", ""]
+    assert rows[3] == ["c", "0", *[""] * (len(PREDICTION_COLUMNS) - 2)]
     write_report(tmp_path / "r.json", report)
     loaded = json.loads((tmp_path / "r.json").read_text())
     assert set(loaded["ranges"]["all"]) == set(METHODS)

@@ -477,3 +477,17 @@ def test_pitch_neutral_is_learned_and_looking_down_is_the_lap() -> None:
 def test_a_sample_without_pitch_is_judged_at_level_pitch() -> None:
     _, _, zones = run_poses(lambda t: None if t < 0 else (0.0, float("nan")), 1.0)
     assert zones[-1] == "road"
+
+
+def test_a_road_pose_outside_the_road_zone_at_first_is_still_learned() -> None:
+    """A camera 16 deg above the line of sight: the road pose reads pitch -16 (below the road
+    zone while the neutral is 0); it is learned within a second and never raises an alert."""
+    config = MonitorConfig(neutral_yaw_deg=0.0)
+    monitor, alerts, zones = run_poses(lambda t: (0.0, -16.0), 10.0, config)
+    assert alerts == []
+    assert zones[0] == "cluster" and zones[-1] == "road"
+    assert zones.index("road") <= FPS  # within a second
+    assert monitor.state.neutral_pitch_deg == pytest.approx(-16.0)
+    lap_glance, _, _ = run_poses(lambda t: (0.0, -16.0 if t < 2.0 else -45.0), 6.0, config)
+    assert lap_glance.state.neutral_pitch_deg == pytest.approx(-16.0)  # a lap glance does not teach
+    assert lap_glance.verdict.zone == "lap"

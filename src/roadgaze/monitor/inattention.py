@@ -10,9 +10,11 @@ Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monit
 - zone: each sample with a face gets a glance zone from its yaw and pitch relative to the neutral
   pose (`roadgaze.monitor.zones`: ordered rectangles, first match wins, else `away`, with
   hysteresis). `road` is on road; every other zone is off road. `neutral` (yaw and pitch) is
-  fixed by `neutral_yaw_deg` / `neutral_pitch_deg` or learned from road samples: a running mean
-  at first, then a first-order filter of time constant `neutral_time_constant_s`, clamped to
-  +-`neutral_limit_deg` / `neutral_pitch_limit_deg`.
+  fixed by `neutral_yaw_deg` / `neutral_pitch_deg` or learned from samples that look roughly
+  ahead (yaw within `road_half_width_deg` of the neutral, pitch within
+  +-`neutral_pitch_limit_deg`): a running mean at first, then a first-order filter of time
+  constant `neutral_time_constant_s`, clamped to +-`neutral_limit_deg` /
+  `neutral_pitch_limit_deg`.
 - face lost: while the head was off road (or, with `turn_away_deg` set, past that yaw), the
   driver is taken as still turned away, i.e. off road (zone: the last zone, `away` if that was
   driving-related); otherwise where they look is unknown (zone None) and, after
@@ -112,16 +114,23 @@ def _learn(value: float, neutral: float, gain: float, limit: float) -> float:
 def _learn_neutral(
     config: MonitorConfig, state: MonitorState, look: _Look, t_s: float
 ) -> tuple[float, float, float, float]:
-    """The neutral yaw and pitch after this sample and the road time each has learned from.
+    """The neutral yaw and pitch after this sample and the time each has learned from.
 
-    Only road samples teach. The gain is the larger of the first-order filter's (time constant
-    `neutral_time_constant_s`) and a running mean's (dt over the time learned so far), so the
-    neutral settles on the driver's road pose within seconds of the start and then follows it
-    slowly.
+    A sample teaches when the head looks roughly ahead: its yaw within `road_half_width_deg` of
+    the neutral yaw and its pitch within +-`neutral_pitch_limit_deg` (where a neutral pitch may
+    lie). This is wider than the road zone, so a camera above or below the line of sight, whose
+    road pose reads outside the road zone at first, is still learned. The gain is the larger of
+    the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
+    over the time learned so far): the neutral settles on the driver's road pose within seconds
+    of the start and then follows it slowly.
     """
     yaw, pitch = state.neutral_yaw_deg, state.neutral_pitch_deg
     yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s
-    if look.gaze is not Gaze.ON_ROAD or look.yaw_deg is None or state.t_s is None:
+    if look.yaw_deg is None or state.t_s is None:
+        return yaw, pitch, yaw_s, pitch_s
+    ahead = abs(look.yaw_deg - yaw) <= config.road_half_width_deg
+    level = look.pitch_deg is None or abs(look.pitch_deg) <= config.neutral_pitch_limit_deg
+    if not (ahead and level):
         return yaw, pitch, yaw_s, pitch_s
     dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
     slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)

@@ -32,7 +32,7 @@ from roadgaze.synth import Timeline, parse_timeline, truth_path_for, write_truth
 
 log = logging.getLogger(__name__)
 
-DRIVE_TIMELINE = "0:3,0/-35:5,0:2,-35:1.5,0:1.5,35:1.5,0:1.5,-50:1.5,0:1.5,30:1.5,0:3"
+DRIVE_TIMELINE = "0:3,0/-35:5,0:2,-35:1.5,0:1.5,35:1.5,0:1.5,-45:1.5,0:1.5,30:1.5,0:3"
 """Road 3 s; a 5 s look down into the lap (a long-distraction alert); four 1.5 s glances (to the
 right, the left mirror, the right mirror, the left mirror) that push the off-road time in the
 last 30 s over 10 s (a VATS alert: mirror glances count); back to the road (cleared).

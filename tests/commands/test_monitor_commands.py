@@ -65,6 +65,23 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
             {"seq": 9, "t_s": 0.3, "yaw_deg": -12.34, "gaze": "on_road"},
             "yaw    car-1 #9 t=0.30s   -12.3° on_road",
         ),
+        (
+            "yaw",
+            {"seq": 9, "t_s": 0.3, "yaw_deg": 1.0, "pitch_deg": -41.26, "zone": "lap"},
+            "yaw    car-1 #9 t=0.30s    +1.0° pitch   -41.3° lap",
+        ),
+        (
+            "yaw",
+            {
+                "seq": 9,
+                "t_s": 0.3,
+                "yaw_deg": None,
+                "pitch_deg": None,
+                "zone": None,
+                "gaze": "unknown",
+            },
+            "yaw    car-1 #9 t=0.30s     --   pitch     --   unknown",
+        ),
         ("state", None, "state  car-1 undecodable payload: garbage"),
     ],
 )

@@ -23,8 +23,10 @@ YAW_RANGES_DEG: tuple[tuple[float, float], ...] = (
     (15.0, 30.0),
     (30.0, 45.0),
     (45.0, 60.0),
+    (60.0, 80.0),
 )
-"""The |true yaw| ranges the measurement reports on; each includes its low end, the last both."""
+"""The |true yaw| ranges the measurement reports on, those below the sweep's limit; each includes
+its low end, the last one reported both."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -87,13 +89,13 @@ def measure_yaw_recovery(
             value = pose.raw_yaw_deg(exact)
             if value is not None:
                 mesh_estimate[index] = value
-    last = len(YAW_RANGES_DEG) - 1
+    reported = [(low, high) for low, high in YAW_RANGES_DEG if low < max_yaw_deg]
+    last = len(reported) - 1
 
     def by_range(values: FloatArray) -> tuple[RangeStats, ...]:
         return tuple(
             range_stats(config.geometry.model, truth, values, low, high, i == last)
-            for i, (low, high) in enumerate(YAW_RANGES_DEG)
-            if low < max_yaw_deg
+            for i, (low, high) in enumerate(reported)
         )
 
     return YawRecovery(

@@ -121,6 +121,12 @@ def test_replay_on_a_synthetic_clip_writes_every_output(
     holding = np.abs(np.gradient(truth[:, 1])) < 1e-9
     assert np.max(np.abs(raw - truth[:, 1])[holding]) < 8.0
     assert len(table.read_text().splitlines()) == len(truth) + 1
+    # the offline columns, null while streaming, are filled at the normal end
+    offline = np.array([r["yaw_offline_deg"] for r in records], dtype=float)
+    assert np.all(np.isfinite(offline[raw == raw]))
+    assert np.max(np.abs(offline - truth[:, 1])[holding]) < 8.0
+    assert all(r["zone"] in ("road", "left_mirror", "away") for r in records)
+    assert "yaw_offline_deg" in table.read_text().splitlines()[0]
     assert cv2.imread(str(plot)) is not None
     capture = cv2.VideoCapture(str(video))
     assert capture.get(cv2.CAP_PROP_FRAME_COUNT) == len(truth)

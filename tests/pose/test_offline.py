@@ -75,3 +75,18 @@ def test_offline_pose_smooths_both_angles_and_rejects_bad_input() -> None:
         rts_smooth([0.0, 0.0, 1.0], [1.0, 2.0, 3.0])
     with pytest.raises(ValueError, match="one length"):
         rts_smooth([0.0, 1.0], [1.0])
+
+
+def test_excursion_is_the_largest_distance_outside_the_nearby_raw_range() -> None:
+    from roadgaze.pose import excursion_deg
+
+    t = np.arange(10) / 10.0
+    raw = np.array([0.0, 0, 0, 0, 10, 10, 10, 10, 10, 10])
+    assert excursion_deg(raw, raw, t) == 0.0
+    overshoot = raw.copy()
+    overshoot[6] = 13.0  # 3 deg above every raw value within +-0.5 s
+    assert excursion_deg(overshoot, raw, t) == pytest.approx(3.0)
+    lagging = raw.copy()
+    lagging[9] = 4.0  # 6 deg below every raw value within +-0.4 s (all 10)
+    assert excursion_deg(lagging, raw, t, half_window_s=0.4) == pytest.approx(6.0)
+    assert excursion_deg([np.nan], [1.0], [0.0]) == 0.0

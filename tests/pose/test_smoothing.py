@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from roadgaze.config import SmoothingConfig
+from roadgaze.pose.offline import excursion_deg
 from roadgaze.pose.smoothing import AngleSmoother, extrapolation_residuals, robust_noise_std_deg
 
 FPS = 30.0
@@ -178,17 +179,6 @@ def run_smoother(t: np.ndarray, values: np.ndarray) -> np.ndarray:
         if result is not None:
             out[i] = result.angle_deg
     return out
-
-
-def excursion_deg(
-    estimate: np.ndarray, raw: np.ndarray, t: np.ndarray, half_s: float = 0.5
-) -> float:
-    """Largest distance of the estimate outside the raw range within +-half_s (frames with raw)."""
-    worst = 0.0
-    for i in np.flatnonzero(np.isfinite(estimate) & np.isfinite(raw)):
-        window = (np.abs(t - t[i]) <= half_s) & np.isfinite(raw)
-        worst = max(worst, estimate[i] - raw[window].max(), raw[window].min() - estimate[i])
-    return worst
 
 
 def test_a_clean_drive_passes_through_without_overshoot() -> None:

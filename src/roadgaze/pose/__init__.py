@@ -22,7 +22,7 @@ from roadgaze.pose.geometry import (
     expected_error_deg,
     forward_model,
 )
-from roadgaze.pose.offline import OfflinePose, offline_pose, rts_smooth
+from roadgaze.pose.offline import OfflinePose, excursion_deg, offline_pose, rts_smooth
 from roadgaze.pose.pitch import (
     CANONICAL_MIDLINE,
     DOWN_GAIN,
@@ -64,6 +64,7 @@ __all__ = [
     "clipped_cylinder_deg",
     "cylindrical",
     "ellipsoidal",
+    "excursion_deg",
     "expected_error_deg",
     "extrapolation_residuals",
     "forward_model",

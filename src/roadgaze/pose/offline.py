@@ -27,7 +27,7 @@ from roadgaze.config import SmoothingConfig
 from roadgaze.pose.smoothing import constant_velocity_model, robust_noise_std_deg
 from roadgaze.types import FloatArray
 
-__all__ = ["OfflinePose", "offline_pose", "rts_smooth"]
+__all__ = ["OfflinePose", "excursion_deg", "offline_pose", "rts_smooth"]
 
 _NEIGHBOURHOOD = 5
 
@@ -84,6 +84,25 @@ def _window_bounds(
         low[rows] = np.minimum(lows[k][start[rows]], lows[k][stop[rows] - width])
         high[rows] = np.maximum(highs[k][start[rows]], highs[k][stop[rows] - width])
     return low, high
+
+
+def excursion_deg(
+    estimate_deg: npt.ArrayLike,
+    raw_deg: npt.ArrayLike,
+    t_s: npt.ArrayLike,
+    half_window_s: float = 0.5,
+) -> float:
+    """Largest distance (degrees) of a smoothed series outside [min, max] of the raw values
+    within +-`half_window_s` of each sample, over the samples with both values; 0 if it never
+    leaves. The measure of overshoot and ringing. `t_s` must increase."""
+    estimate = np.asarray(estimate_deg, dtype=np.float64)
+    raw = np.asarray(raw_deg, dtype=np.float64)
+    low, high = _window_bounds(raw, np.asarray(t_s, dtype=np.float64), half_window_s)
+    both = np.isfinite(estimate) & np.isfinite(raw)
+    if not np.any(both):
+        return 0.0
+    outside = np.maximum(estimate[both] - high[both], low[both] - estimate[both])
+    return max(0.0, float(np.max(outside)))
 
 
 def _smooth_track(t_s: FloatArray, values: FloatArray, config: SmoothingConfig) -> FloatArray:

@@ -34,7 +34,6 @@ __all__ = [
     "POSE_TIMELINE",
     "ChannelErrors",
     "ClipMeasurement",
-    "excursion_deg",
     "format_clip_measurement",
     "measure_clip",
 ]
@@ -48,19 +47,6 @@ up, to the centre stack (-20/-35) and up-left, each from the road."""
 
 NEUTRAL_WINDOW_S = 3.0
 EXCURSION_WINDOW_S = 0.5
-
-
-def excursion_deg(
-    estimate: FloatArray, raw: FloatArray, t_s: FloatArray, half_window_s: float = 0.5
-) -> float:
-    """Largest distance (degrees) of the estimate outside [min, max] of the raw values within
-    +-`half_window_s`, over the frames with a raw value and an estimate; 0 when it never leaves."""
-    worst = 0.0
-    for i in np.flatnonzero(np.isfinite(estimate) & np.isfinite(raw)):
-        window = (np.abs(t_s - t_s[i]) <= half_window_s) & np.isfinite(raw)
-        worst = max(worst, float(estimate[i] - raw[window].max()))
-        worst = max(worst, float(raw[window].min() - estimate[i]))
-    return worst
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,7 +83,7 @@ def _smooth_online(t_s: FloatArray, raw: FloatArray, config: SmoothingConfig) ->
 def _channel(
     t_s: FloatArray, raw: FloatArray, truth: FloatArray, config: SmoothingConfig
 ) -> tuple[ChannelErrors, FloatArray]:
-    from roadgaze.pose import rts_smooth
+    from roadgaze.pose import excursion_deg, rts_smooth
 
     online = _smooth_online(t_s, raw, config)
     offline = rts_smooth(t_s, raw, config)

@@ -233,3 +233,14 @@ def test_noise_is_measured_from_the_series() -> None:
     for i, value in enumerate(turning + rng.normal(0.0, 3.0, t.size)):
         smoother.update(float(t[i]), float(value))
     assert smoother.state.measurement_std_deg == pytest.approx(3.0, abs=0.8)
+
+
+@pytest.mark.parametrize("dt_s", [1 / 30, 1 / 15, 0.4])
+def test_the_process_noise_is_filterpys_piecewise_white_acceleration(dt_s: float) -> None:
+    from filterpy.common import Q_discrete_white_noise
+
+    from roadgaze.pose.smoothing import constant_velocity_model
+
+    transition, noise = constant_velocity_model(dt_s, 300.0)
+    np.testing.assert_allclose(noise, Q_discrete_white_noise(dim=2, dt=dt_s, var=300.0**2))
+    np.testing.assert_array_equal(transition, [[1.0, dt_s], [0.0, 1.0]])

@@ -25,11 +25,11 @@ doing harm where the raw series is already good (docs/pose.md has the measuremen
 from __future__ import annotations
 
 import math
+import statistics
 from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
-from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
 from roadgaze.config import SmoothingConfig
@@ -77,10 +77,17 @@ def robust_noise_std_deg(t_s: FloatArray, values: FloatArray) -> float:
 def constant_velocity_model(
     dt_s: float, acceleration_std_dps2: float
 ) -> tuple[FloatArray, FloatArray]:
-    """Transition F and process noise Q of the constant-velocity model over `dt_s` seconds."""
+    """Transition F and process noise Q of the constant-velocity model over `dt_s` seconds.
+
+    Q is filterpy's `Q_discrete_white_noise(dim=2, dt, var)` (piecewise white acceleration),
+    written out: var * [[dt^4/4, dt^3/2], [dt^3/2, dt^2]].
+    """
     transition = np.array([[1.0, dt_s], [0.0, 1.0]])
-    noise = Q_discrete_white_noise(dim=2, dt=dt_s, var=acceleration_std_dps2**2)
-    return transition, np.asarray(noise, dtype=np.float64)
+    var = acceleration_std_dps2**2
+    noise = var * np.array(
+        [[dt_s**4 / 4.0, dt_s**3 / 2.0], [dt_s**3 / 2.0, dt_s**2]], dtype=np.float64
+    )
+    return transition, noise
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,6 +128,7 @@ class AngleSmoother:
         """Accepted (t_s, value) within `clamp_window_s`: bounded by the frame rate."""
         self._history: deque[tuple[float, float]] = deque(maxlen=3)
         self._residuals: deque[float] = deque(maxlen=self.config.noise_window)
+        self._noise_std_deg = self.config.measurement_std_deg
         self._consecutive_rejections = 0
         self._rejected_total = 0
         self._reinitialisations = 0
@@ -136,11 +144,7 @@ class AngleSmoother:
 
     def measurement_std_deg(self) -> float:
         """The measurement noise assumed now: measured once enough residuals exist."""
-        config = self.config
-        if len(self._residuals) < config.min_noise_samples:
-            return config.measurement_std_deg
-        measured = MAD_TO_STD * float(np.median(np.abs(np.asarray(self._residuals))))
-        return max(measured, config.min_measurement_std_deg)
+        return self._noise_std_deg
 
     @property
     def state(self) -> SmootherState:
@@ -238,7 +242,7 @@ class AngleSmoother:
         self._learn_noise(t_s, value_deg)
 
     def _predict(self, dt_s: float) -> None:
-        if dt_s != self._model_dt_s:  # most streams repeat one dt: build F and Q once
+        if not abs(dt_s - self._model_dt_s) <= 1e-9:  # most streams repeat one dt: F, Q once
             self._model_dt_s = dt_s
             self._model = constant_velocity_model(dt_s, self.config.acceleration_std_dps2)
         transition, noise = self._model
@@ -253,10 +257,16 @@ class AngleSmoother:
 
     def _learn_noise(self, t_s: float, value_deg: float) -> None:
         self._history.append((t_s, value_deg))
-        if len(self._history) == 3:
-            times = np.array([item[0] for item in self._history])
-            values = np.array([item[1] for item in self._history])
-            self._residuals.extend(extrapolation_residuals(times, values).tolist())
+        if len(self._history) < 3:
+            return
+        (t0, z0), (t1, z1), (t2, z2) = self._history
+        ratio = (t2 - t1) / (t1 - t0)
+        residual = z2 - z1 - (z1 - z0) * ratio  # as `extrapolation_residuals`, one at a time
+        self._residuals.append(residual / math.sqrt(1.0 + (1.0 + ratio) ** 2 + ratio**2))
+        config = self.config
+        if len(self._residuals) >= config.min_noise_samples:
+            spread = statistics.median(abs(r) for r in self._residuals)
+            self._noise_std_deg = max(MAD_TO_STD * spread, config.min_measurement_std_deg)
 
     def _clamp(self, t_s: float, value_deg: float | None) -> None:
         """Add an accepted value (None: none) and clamp the estimate to the recent raw range."""

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from roadgaze.config import Config, SmoothingConfig
-from roadgaze.evaluation.stats import RangeStats, range_stats
+from roadgaze.evaluation.stats import ErrorStats, RangeStats, range_stats
 from roadgaze.synth.clip import DEFAULT_FPS, render_clip
 from roadgaze.synth.measure import PITCH_RANGES_DEG, zone_agreement
 from roadgaze.synth.renderer import DEFAULT_SIZE, FaceRenderer, load_photo
@@ -314,12 +314,17 @@ def format_clip_measurement(result: ClipMeasurement) -> str:
         lines.append(_channel_line("yaw", result.noisy_yaw))
         lines.append(_channel_line("pitch", result.noisy_pitch))
     lines.append("pitch error per |true pitch| range (relative to the neutral): MAE / mean error")
+
+    def cell(stats: ErrorStats) -> str:
+        if not stats.n_valid:
+            return f"{'-':>5} / {'-':>6}"
+        return f"{stats.mae_deg:5.2f} / {stats.bias_deg:+6.2f}"
+
     for raw, online in result.pitch_ranges:
         label = f"{raw.low_deg:g}-{raw.high_deg:g}"
         lines.append(
-            f"  {label:>6} frames {raw.stats.n_images:>4} | raw {raw.stats.mae_deg:5.2f} / "
-            f"{raw.stats.bias_deg:+6.2f} | online {online.stats.mae_deg:5.2f} / "
-            f"{online.stats.bias_deg:+6.2f}"
+            f"  {label:>6} frames {raw.stats.n_images:>4} | raw {cell(raw.stats)} | "
+            f"online {cell(online.stats)}"
         )
     lines.extend(zone_agreement(result.truth_zone, result.zone))
     return "\n".join(lines)

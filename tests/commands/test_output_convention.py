@@ -19,8 +19,8 @@ from skimage import data as skimage_data
 from roadgaze.cli import main
 from roadgaze.logs import ProgressAwareHandler, records_dropped, setup_logging
 
-GLANCE = "0:1,40:3.8,0:1"
-"""One 3.8 s glance: a long_distraction warning, then cleared."""
+GLANCE = "0:1,0/-35:3.8,0:1"
+"""One 3.8 s look into the lap: a long_distraction warning, then cleared."""
 LOG_LINE = re.compile(r"^\d{4}-\d\d-\d\d \d\d:\d\d:\d\d,\d{3} (INFO|WARNING|ERROR) roadgaze")
 
 

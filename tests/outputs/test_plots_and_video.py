@@ -16,7 +16,8 @@ from roadgaze.outputs import PANEL_LINES, AlertBoard, YawPlot, annotate, label_r
 from roadgaze.outputs.plots import road_bands_deg
 from roadgaze.types import Alert, AlertKind, AlertLevel, FrameRecord, PoseSample
 
-FIXED = MonitorConfig(neutral_yaw_deg=0.0)
+FIXED = MonitorConfig(neutral_yaw_deg=0.0, zones=[], driving_related_zones=[])
+"""No zones but the road: any glance off it is a distraction."""
 
 
 def monitored(config: MonitorConfig, yaws: list[tuple[float, float]]) -> list[FrameRecord]:
@@ -100,7 +101,7 @@ def test_plot_keeps_what_the_monitor_decided(tmp_path: Path) -> None:
 
 
 def test_an_alert_stays_on_screen_until_cleared() -> None:
-    config = MonitorConfig(neutral_yaw_deg=0.0)
+    config = FIXED
     board = AlertBoard()
     shown = {round(r.t_s, 1): board.update(r) for r in monitored(config, glance(7.0))}
     assert shown[3.9] == []
@@ -139,6 +140,7 @@ def test_a_banner_is_drawn_at_the_top() -> None:
 def test_panel_lines_show_the_gaze_and_the_timers_against_their_thresholds() -> None:
     record = monitored(FIXED, glance(4.0))[25]  # 1.5 s into the glance
     lines = [line(record, FIXED) for line in PANEL_LINES]
-    assert "gaze OFF_ROAD  neutral +0.0 deg" in lines[2]
-    assert lines[3] == "off road 1.5/3 s  in VATS window 1.5/10 s"
-    assert [line(record, None) for line in PANEL_LINES][3] == "off road 1.5 s  in VATS window 1.5 s"
+    assert lines[2] == "zone AWAY  neutral +0.0/+0.0 deg  speed unknown (counting)"
+    assert lines[3] == "off road 1.5 s  distraction 1.5/3 s  VATS window 1.5/10 s"
+    without_thresholds = [line(record, None) for line in PANEL_LINES][3]
+    assert without_thresholds == "off road 1.5 s  distraction 1.5 s  VATS window 1.5 s"

@@ -31,11 +31,13 @@ def register(subparsers: Any) -> None:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "replay",
         parents=[common_options()],
-        help="run the yaw pipeline over a video and write one record per frame",
-        description="Run capture -> landmarks -> Center-CE yaw -> Kalman smoother -> monitor "
+        help="run the pose pipeline over a video and write one record per frame",
+        description="Run capture -> landmarks -> yaw, pitch, roll -> smoother -> monitor (zones) "
         "over a video file (or image folder, or camera) and write one JSON object per frame, to "
-        "stdout unless --out names a file. A progress bar with fps and ETA, the log (each alert "
-        "once) and a closing summary go to stderr.",
+        "stdout unless --out names a file. The records are written line by line; at the normal "
+        "end the files (not stdout) are rewritten once with the offline (RTS) yaw_offline_deg and "
+        "pitch_offline_deg filled (alerts stay computed from the causal estimate). A progress bar "
+        "with fps and ETA, the log (each alert once) and a closing summary go to stderr.",
     )
     add_arguments(parser)
     parser.set_defaults(handler=run)
@@ -185,5 +187,23 @@ def run(args: argparse.Namespace, config: Config) -> int:
         sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack, config)]
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
+    fill_offline(args, config)
     report(args, summary, stats)
     return 0
+
+
+def fill_offline(args: argparse.Namespace, config: Config) -> None:
+    """At the normal end of a replay: the offline columns of the written record files (not of
+    stdout), each file rewritten atomically; a file that cannot be done keeps its nulls."""
+    from roadgaze.errors import RoadgazeError
+    from roadgaze.outputs import fill_offline_columns
+
+    paths = [Path(args.out)] if args.out is not None and args.out != "-" else []
+    paths += [args.csv] if args.csv is not None else []
+    for path in paths:
+        try:
+            fill_offline_columns(path, config.smoothing)
+        except RoadgazeError as exc:
+            log.warning("replay %s: offline columns left null: %s", args.source, exc)
+            continue
+        log.debug("replay %s: offline columns filled in %s", args.source, path)

@@ -8,9 +8,11 @@ from roadgaze.outputs.annotate import (
     annotate,
     verdict_text,
 )
+from roadgaze.outputs.offline import fill_offline_columns
 from roadgaze.outputs.plots import SERIES, Series, YawPlot, label_rows
 from roadgaze.outputs.progress import ProgressBar
 from roadgaze.outputs.records import (
+    OFFLINE_FIELDS,
     RECORD_FIELDS,
     CsvWriter,
     JsonlWriter,
@@ -22,6 +24,7 @@ from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
 
 __all__ = [
     "FOURCC_BY_SUFFIX",
+    "OFFLINE_FIELDS",
     "PANEL_LINES",
     "RECORD_FIELDS",
     "SERIES",
@@ -34,6 +37,7 @@ __all__ = [
     "Series",
     "YawPlot",
     "annotate",
+    "fill_offline_columns",
     "label_rows",
     "open_for_writing",
     "open_video_writer",

@@ -128,9 +128,9 @@ class AlertBoard:
 
 
 def verdict_text(record: FrameRecord) -> str:
-    """One line: the gaze, the off-road times and the alerts raised on this frame."""
+    """One line: the zone (or gaze), the off-road times and the alerts raised on this frame."""
     verdict = record.verdict
-    text = f"gaze {verdict.gaze.value}"
+    text = f"gaze {verdict.gaze.value}" if verdict.zone is None else f"zone {verdict.zone}"
     if round(verdict.off_road_s, 3):
         text += f"  off road {verdict.off_road_s:.1f} s"
     text += f"  in window {verdict.window_off_road_s:.1f} s"
@@ -277,9 +277,9 @@ def yaw_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
         return "--" if value is None else f"{value:+.1f}{unit}"
 
     return (
-        f"yaw {number(sample.yaw_deg, '')} (raw {number(sample.yaw_raw_deg, '')}) deg  "
-        f"rate {number(sample.yaw_rate_dps, '')} dps  "
-        f"sd {'--' if sample.yaw_std_deg is None else f'{sample.yaw_std_deg:.1f}'}"
+        f"yaw {number(sample.yaw_deg, '')} (raw {number(sample.yaw_raw_deg, '')})  "
+        f"pitch {number(sample.pitch_deg, '')}  roll {number(sample.roll_deg, '')} deg  "
+        f"rate {number(sample.yaw_rate_dps, '')} dps"
     )
 
 
@@ -294,26 +294,32 @@ def state_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
 
 
 def gaze_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
-    """Where the driver looks, against which neutral, and whether time counts (speed)."""
+    """Where the driver looks (the zone), against which neutral, and whether time counts."""
     verdict = record.verdict
+    where = (
+        f"gaze {verdict.gaze.value.upper()}"
+        if verdict.zone is None
+        else (f"zone {verdict.zone.upper()}")
+    )
     speed = "speed unknown" if verdict.speed_kmh is None else f"{verdict.speed_kmh:.0f} km/h"
     counting = "counting" if verdict.moving else "not counting"
     return (
-        f"gaze {verdict.gaze.value.upper()}  neutral {verdict.neutral_yaw_deg:+.1f} deg  "
+        f"{where}  neutral {verdict.neutral_yaw_deg:+.1f}/{verdict.neutral_pitch_deg:+.1f} deg  "
         f"{speed} ({counting})"
     )
 
 
 def timers_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
-    """The off-road timers, against their thresholds when the configuration is known."""
+    """The off-road timers, against their thresholds when the configuration is known: the
+    distraction (long-distraction) timer and the time within the VATS window."""
     verdict = record.verdict
 
     def of(value_s: float, limit_s: float | None) -> str:
         return f"{value_s:.1f} s" if limit_s is None else f"{value_s:.1f}/{limit_s:g} s"
 
-    glance = of(verdict.off_road_s, None if monitor is None else monitor.long_distraction_s)
+    glance = of(verdict.distraction_s, None if monitor is None else monitor.long_distraction_s)
     window = of(verdict.window_off_road_s, None if monitor is None else monitor.vats_threshold_s)
-    return f"off road {glance}  in VATS window {window}"
+    return f"off road {verdict.off_road_s:.1f} s  distraction {glance}  VATS window {window}"
 
 
 PanelLine = Callable[[FrameRecord, MonitorConfig | None], str]

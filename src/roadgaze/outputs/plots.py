@@ -1,11 +1,11 @@
-"""The yaw plot: what the monitor saw and decided, frame by frame, in one PNG.
+"""The pose plot: what the monitor saw and decided, frame by frame, in one PNG.
 
-Panels, top to bottom: the alerts (labels laid out in rows so that none overlap), the yaw (raw,
-smoothed with its +-2 sigma band, the truth when known; the road-ahead band around the monitor's
+Panels, top to bottom: the alerts (labels laid out in rows so that none overlap); the yaw (raw,
+smoothed with its +-2 sigma band, the truth when known; the road zone around the monitor's
 learned neutral, with the narrower band the head must come back into (hysteresis); spans judged
-off road shaded) and the off-road timers with their thresholds (the continuous episode and the
-time within the VATS window). Each plotted value is one `Series`: a new record field is one more
-entry in `SERIES`.
+off road shaded); the pitch the same way, when the records have one; the off-road timers with
+their thresholds (the glance, the long-distraction timer, the time within the VATS window). Each
+plotted value is one `Series`: a new record field is one more entry in `SERIES`.
 """
 
 from __future__ import annotations
@@ -39,19 +39,31 @@ class Series:
     style: Mapping[str, Any]
 
 
+RAW_STYLE = {"ls": "", "marker": ".", "markersize": 3, "color": "tab:gray"}
 SERIES: tuple[Series, ...] = (
-    Series("raw", lambda r: r.sample.yaw_raw_deg, "yaw",
-           {"ls": "", "marker": ".", "markersize": 3, "color": "tab:gray"}),
+    Series("raw", lambda r: r.sample.yaw_raw_deg, "yaw", RAW_STYLE),
     Series("smoothed (Kalman)", lambda r: r.sample.yaw_deg, "yaw", {"color": "tab:blue"}),
+    Series("raw pitch", lambda r: r.sample.pitch_raw_deg, "pitch", RAW_STYLE),
+    Series("smoothed pitch", lambda r: r.sample.pitch_deg, "pitch", {"color": "tab:purple"}),
     Series("off road, this glance", lambda r: r.verdict.off_road_s, "timers",
-           {"color": "tab:red"}),
+           {"color": "tab:red", "lw": 0.8}),
+    Series("distraction (long-distraction timer)", lambda r: r.verdict.distraction_s, "timers",
+           {"color": "tab:orange"}),
     Series("off road in the VATS window", lambda r: r.verdict.window_off_road_s, "timers",
            {"color": "tab:purple"}),
 )  # fmt: skip
-"""What is plotted; pitch, zones or eyes join with one line here (and a panel in `PANELS`)."""
+"""What is plotted; a new record field (eyes, ...) joins with one line here (and a panel in
+`PANELS` if it needs a new one)."""
 
-PANELS = {"yaw": "yaw (deg, + = driver's left)", "timers": "off-road time (s)"}
-"""The value panels, top to bottom, with their y labels."""
+PANELS = {
+    "yaw": "yaw (deg, + = driver's left)",
+    "pitch": "pitch (deg, + = up)",
+    "timers": "off-road time (s)",
+}
+"""The value panels, top to bottom, with their y labels; a panel whose values are all missing
+(pitch from an old record) is left out."""
+TRUTH_COLUMNS = {"yaw": 1, "pitch": 2}
+"""Column of the truth array (`t_s, yaw_deg, pitch_deg`) drawn in each panel."""
 
 
 def label_rows(spans: Sequence[tuple[float, float]], gap: float = 0.0) -> list[int]:
@@ -85,6 +97,19 @@ def road_bands_deg(
     return (neutral_deg - half, neutral_deg + half), (neutral_deg - back, neutral_deg + back)
 
 
+def road_pitch_bands_deg(
+    neutral_deg: FloatArray, monitor: MonitorConfig
+) -> tuple[tuple[FloatArray, FloatArray], tuple[FloatArray, FloatArray]]:
+    """The road zone's pitch limits per frame, degrees: left beyond neutral + `road_pitch_deg`
+    grown by `hysteresis_deg`, entered again within neutral + `road_pitch_deg`."""
+    low, high = monitor.road_pitch_deg
+    grow = monitor.hysteresis_deg
+    return (neutral_deg + low - grow, neutral_deg + high + grow), (
+        neutral_deg + low,
+        neutral_deg + high,
+    )
+
+
 def _runs(flags: Sequence[bool]) -> list[tuple[int, int]]:
     """(first, last) index of each run of True."""
     runs: list[tuple[int, int]] = []
@@ -108,8 +133,8 @@ class YawPlot(ClosesOnExit):
     `monitor`: the monitor's configuration, for the road band (around each frame's learned
     neutral, with the hysteresis) and the timer thresholds; without it they are not drawn.
     `road_half_width_deg` alone (older callers) stands for a monitor with that width.
-    `truth`: rows of `t_s, yaw_deg, ...`. After `close`, `label_boxes` holds each alert label's
-    box in the saved figure (display pixels), for checking the layout.
+    `truth`: rows of `t_s, yaw_deg[, pitch_deg]`. After `close`, `label_boxes` holds each alert
+    label's box in the saved figure (display pixels), for checking the layout.
     """
 
     def __init__(
@@ -130,6 +155,7 @@ class YawPlot(ClosesOnExit):
         self.values: dict[str, list[float]] = {series.label: [] for series in SERIES}
         self.std_deg: list[float] = []
         self.neutral_deg: list[float] = []
+        self.neutral_pitch_deg: list[float] = []
         self.gaze: list[Gaze] = []
         self.alerts: list[Alert] = []
         self.label_boxes: list[tuple[float, float, float, float]] = []
@@ -144,12 +170,21 @@ class YawPlot(ClosesOnExit):
     def raw_deg(self) -> list[float]:
         return self.values["raw"]
 
+    @property
+    def pitch_deg(self) -> list[float]:
+        return self.values["smoothed pitch"]
+
+    @property
+    def pitch_raw_deg(self) -> list[float]:
+        return self.values["raw pitch"]
+
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         self.t_s.append(record.sample.t_s)
         for series in SERIES:
             self.values[series.label].append(_nan_for_none(series.value(record)))
         self.std_deg.append(_nan_for_none(record.sample.yaw_std_deg))
         self.neutral_deg.append(record.verdict.neutral_yaw_deg)
+        self.neutral_pitch_deg.append(record.verdict.neutral_pitch_deg)
         self.gaze.append(record.verdict.gaze)
         self.alerts.extend(record.alerts)
 
@@ -162,7 +197,12 @@ class YawPlot(ClosesOnExit):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        panels = [name for name in PANELS if any(s.panel == name for s in SERIES)]
+        panels = [
+            name
+            for name in PANELS
+            if name == "yaw"
+            or any(np.isfinite(self.values[s.label]).any() for s in SERIES if s.panel == name)
+        ]
         figure, axes_list = plt.subplots(
             len(panels) + 1,
             1,
@@ -175,11 +215,18 @@ class YawPlot(ClosesOnExit):
         axes = dict(zip(panels, value_axes, strict=True))
         t_s = np.asarray(self.t_s)
         self._draw_yaw(axes["yaw"], t_s)
+        if "pitch" in axes:
+            self._draw_pitch(axes["pitch"], t_s)
         if "timers" in axes:
             self._draw_timers(axes["timers"])
+        for name, column in TRUTH_COLUMNS.items():
+            if name in axes and self.truth is not None and self.truth.shape[1] > column:
+                axes[name].plot(self.truth[:, 0], self.truth[:, column], "-", color="black",
+                                lw=1.2, label="truth")  # fmt: skip
         for series in SERIES:
-            axes[series.panel].plot(t_s, self.values[series.label], label=series.label,
-                                    **series.style)  # fmt: skip
+            if series.panel in axes:
+                axes[series.panel].plot(t_s, self.values[series.label], label=series.label,
+                                        **series.style)  # fmt: skip
         for name, panel in axes.items():
             panel.set_ylabel(PANELS[name], fontsize=8)
             panel.grid(alpha=0.3)
@@ -188,7 +235,7 @@ class YawPlot(ClosesOnExit):
                 colour = ALERT_COLOURS.get(alert.level.value, "tab:purple")
                 panel.axvline(alert.t_s, color=colour, linestyle="--", linewidth=0.9)
         value_axes[-1].set_xlabel("time (s)")
-        events.set_title(self.title or "head yaw")
+        events.set_title(self.title or "head pose")
         figure.tight_layout()
         self._draw_alert_labels(figure, events)
         try:
@@ -217,9 +264,18 @@ class YawPlot(ClosesOnExit):
                 end = t_s[last + 1] if last + 1 < len(t_s) else t_s[last]
                 axes.axvspan(t_s[first], end, color=colour, alpha=0.08, lw=0,
                              label=label if number == 0 else None)  # fmt: skip
-        if self.truth is not None:
-            axes.plot(self.truth[:, 0], self.truth[:, 1], "-", color="black", lw=1.2, label="truth")
         axes.fill_between(t_s, smoothed - 2 * std, smoothed + 2 * std, alpha=0.2, label="±2σ")
+        axes.axhline(0.0, color="black", linewidth=0.5)
+
+    def _draw_pitch(self, axes: Any, t_s: FloatArray) -> None:
+        if self.monitor is not None and len(t_s):
+            neutral = np.asarray(self.neutral_pitch_deg)
+            (low, high), (back_low, back_high) = road_pitch_bands_deg(neutral, self.monitor)
+            axes.fill_between(t_s, low, high, color="tab:green", alpha=0.07,
+                              label="road zone (pitch)")  # fmt: skip
+            axes.fill_between(t_s, back_low, back_high, color="tab:green", alpha=0.1,
+                              label="back on road within")  # fmt: skip
+            axes.plot(t_s, neutral, "--", color="tab:green", lw=0.8, label="learned neutral")
         axes.axhline(0.0, color="black", linewidth=0.5)
 
     def _draw_timers(self, axes: Any) -> None:
@@ -266,7 +322,7 @@ class YawPlot(ClosesOnExit):
             else:
                 text.set_y(1.0 - (row + 0.5) / shown)
         if self.unlabelled_alerts:
-            events.set_title(f"{self.title or 'head yaw'} ({self.unlabelled_alerts} more alerts "
+            events.set_title(f"{self.title or 'head pose'} ({self.unlabelled_alerts} more alerts "
                              "marked but not labelled)")  # fmt: skip
         figure.canvas.draw()
         self.label_boxes = [

@@ -243,7 +243,7 @@ def main() -> int:
         eval_run = None if args.no_eval else evaluate(work)
         soak_run = soak(video, args.soak) if args.soak else None
         after = load_average()
-        measured = {
+        measured: dict[str, Any] = {
             "host": machine(),
             "loads": (before, after),
             "demo_run": demo_run,

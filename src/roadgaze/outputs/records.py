@@ -19,6 +19,7 @@ from typing import IO, Any
 from roadgaze.errors import RoadgazeError
 from roadgaze.types import Alert, ClosesOnExit, Frame, FrameRecord
 
+
 class FieldType(StrEnum):
     """The type of one field of a flat record; every field may also be None (null)."""
 

@@ -1,0 +1,352 @@
+"""The task of a batch: one drive through the one loop, written as Parquet, summed up in one row.
+
+`process_drive(task)` is what both engines run, by name, in their worker processes. It never
+raises for a bad drive: a missing, empty, corrupt or unreadable video becomes a `DriveResult`
+with `status="failed"` and a one-line `error`. A drive whose outputs already exist and match
+its fingerprint (the input's size and mtime, or its SHA-256; the roadgaze version; the
+configuration; the drive's metadata) is not run again: its stored summary comes back with
+`resumed=True`. Every drive gets a fresh VIDEO-mode landmarker (one reused across files carries
+its tracking state over and loses faces).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import math
+import time
+from contextlib import ExitStack
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any, Literal
+
+from roadgaze import __version__
+from roadgaze.config import Config
+from roadgaze.errors import RoadgazeError
+from roadgaze.fleet.drives import Drive
+from roadgaze.fleet.tables import (
+    AtomicParquetWriter,
+    alerts_schema,
+    frames_schema,
+    read_drive_metadata,
+)
+from roadgaze.outputs.records import alert_fields, record_fields
+from roadgaze.pipeline import StopSignal
+from roadgaze.types import AlertKind, AlertLevel, Frame, FrameRecord, Gaze
+
+log = logging.getLogger(__name__)
+
+Status = Literal["ok", "failed", "interrupted", "pending"]
+"""ok: outputs written (now or by an earlier run); failed: see `error`; interrupted: stopped
+before its end, nothing written; pending: not started before the batch was stopped."""
+
+ALERT_KINDS = tuple(kind.value for kind in AlertKind if kind is not AlertKind.CLEARED)
+"""The kinds counted per drive (`cleared` ends alerts; it is not one)."""
+
+HASH_CHUNK_BYTES = 1 << 20
+
+
+@dataclass(frozen=True, slots=True)
+class DriveTask:
+    """Everything a worker needs for one drive (picklable: it travels to worker processes)."""
+
+    drive: Drive
+    out_dir: Path
+    config: Config
+    content_hash: bool = False
+    """Fingerprint the input by its SHA-256 instead of its size and modification time."""
+    version: str = __version__
+    """The roadgaze version of the batch; a worker with another version refuses the drive."""
+
+
+@dataclass(frozen=True, slots=True)
+class DriveResult:
+    """One drive's outcome and summary: one row of `summary.parquet`."""
+
+    drive_id: str
+    path: str
+    driver_id: str | None
+    vehicle_id: str | None
+    start_time: str | None
+    """ISO 8601 with its zone."""
+    status: Status
+    resumed: bool = False
+    """The outputs come from an earlier run (the input and configuration had not changed)."""
+    error: str | None = None
+    warning: str | None = None
+    """A problem that did not stop the drive, e.g. a video that ended before its announced end."""
+    frames: int = 0
+    frames_with_face: int = 0
+    frames_gaze_known: int = 0
+    """Frames on which the monitor knew the gaze (on or off road)."""
+    frames_off_road: int = 0
+    duration_s: float = 0.0
+    """Video time from the first frame to the end of the last one."""
+    alert_counts: tuple[tuple[str, int], ...] = ()
+    """Alerts raised by kind; a long distraction escalated to critical counts once."""
+    critical_alerts: int = 0
+    longest_off_road_s: float = 0.0
+    """The longest continuous counted off-road episode (the monitor's `off_road_s`)."""
+    neutral_yaw_deg: float | None = None
+    """The monitor's road-ahead yaw at the end of the drive (learned unless configured)."""
+    processing_fps: float = 0.0
+    """Frames per second of the loop on this drive (start-up excluded)."""
+    startup_s: float = 0.0
+    """Opening the video and creating the landmarker."""
+    wall_s: float = 0.0
+    """The whole task, start-up and writing included."""
+
+    @classmethod
+    def of(cls, drive: Drive, status: Status, **values: Any) -> DriveResult:
+        start = drive.start_time.isoformat() if drive.start_time is not None else None
+        return cls(
+            drive_id=drive.drive_id,
+            path=str(drive.path),
+            driver_id=drive.driver_id,
+            vehicle_id=drive.vehicle_id,
+            start_time=start,
+            status=status,
+            **values,
+        )
+
+    @property
+    def face_found_rate(self) -> float | None:
+        return self.frames_with_face / self.frames if self.frames else None
+
+    @property
+    def off_road_ratio(self) -> float | None:
+        """Off-road frames over frames whose gaze is known."""
+        return self.frames_off_road / self.frames_gaze_known if self.frames_gaze_known else None
+
+    def to_json(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_json(cls, values: dict[str, Any]) -> DriveResult:
+        counts = tuple((str(k), int(n)) for k, n in values.get("alert_counts", ()))
+        return cls(**{**values, "alert_counts": counts})
+
+
+def output_paths(out_dir: Path, drive_id: str) -> tuple[Path, Path]:
+    """`frames/<drive_id>.parquet` and `alerts/<drive_id>.parquet` under `out_dir`."""
+    return out_dir / "frames" / f"{drive_id}.parquet", out_dir / "alerts" / f"{drive_id}.parquet"
+
+
+def config_hash(config: Config) -> str:
+    """A short hash of the settings that change a drive's records."""
+    sections = {
+        name: getattr(config, name).model_dump(mode="json")
+        for name in ("geometry", "landmarks", "smoothing", "monitor")
+    }
+    return hashlib.sha256(json.dumps(sections, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def fingerprint_of(task: DriveTask) -> dict[str, Any]:
+    """What the outputs of a drive depend on; raises OSError when the input cannot be read."""
+    drive = task.drive
+    stat = drive.path.stat()
+    source: dict[str, Any] = {"size": stat.st_size, "mtime_ns": stat.st_mtime_ns}
+    if task.content_hash:
+        digest = hashlib.sha256()
+        with drive.path.open("rb") as handle:
+            while chunk := handle.read(HASH_CHUNK_BYTES):
+                digest.update(chunk)
+        source["sha256"] = digest.hexdigest()
+    return {
+        "input": source,
+        "version": task.version,
+        "config": config_hash(task.config),
+        "drive": [drive.driver_id, drive.vehicle_id, DriveResult.of(drive, "ok").start_time],
+    }
+
+
+def fingerprints_match(stored: Any, current: dict[str, Any], content_hash: bool) -> bool:
+    """Same version, configuration and metadata, and the same input: the same SHA-256 and size
+    with `content_hash`, else the same size and modification time."""
+    if not isinstance(stored, dict) or not isinstance(stored.get("input"), dict):
+        return False
+    if any(stored.get(key) != current[key] for key in ("version", "config", "drive")):
+        return False
+    keys = ("size", "sha256") if content_hash else ("size", "mtime_ns")
+    return all(stored["input"].get(key) == current["input"][key] for key in keys)
+
+
+def find_done(task: DriveTask, fingerprint: dict[str, Any] | None = None) -> DriveResult | None:
+    """The stored result of a drive whose outputs exist and match; None when it must run."""
+    try:
+        current = fingerprint if fingerprint is not None else fingerprint_of(task)
+    except OSError:
+        return None
+    frames_path, alerts_path = output_paths(task.out_dir, task.drive.drive_id)
+    frames_meta, alerts_meta = read_drive_metadata(frames_path), read_drive_metadata(alerts_path)
+    if frames_meta is None or alerts_meta is None or "summary" not in frames_meta:
+        return None
+    if not all(
+        fingerprints_match(meta.get("fingerprint"), current, task.content_hash)
+        for meta in (frames_meta, alerts_meta)
+    ):
+        return None
+    try:
+        stored = DriveResult.from_json(frames_meta["summary"])
+    except (TypeError, ValueError):
+        return None
+    return replace(stored, path=str(task.drive.path), resumed=True)
+
+
+_stop: StopSignal | None = None
+
+
+def use_stop_signal(stop: StopSignal | None) -> None:
+    """Let `stop` end the drive in progress between two frames (a worker process sets this)."""
+    global _stop
+    _stop = stop
+
+
+def one_line(exc: BaseException, limit: int = 300) -> str:
+    """An exception as one line: its message (its first line for a long one, e.g. a remote
+    traceback), prefixed with its type unless it is a `RoadgazeError`."""
+    lines = str(exc).strip().splitlines() or [""]
+    text = " ".join(lines[0].split()) if len(lines) > 3 else " ".join(" ".join(lines).split())
+    text = text if isinstance(exc, RoadgazeError) else f"{type(exc).__name__}: {text}"
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def process_drive(task: DriveTask) -> DriveResult:
+    """Run one drive and write its outputs; never raises for a bad drive (see the module doc).
+
+    A KeyboardInterrupt (Ray's cancellation) passes through after the temporary files are gone.
+    """
+    started = time.perf_counter()
+    drive = task.drive
+    if task.version != __version__:
+        return DriveResult.of(
+            drive,
+            "failed",
+            error=f"this worker runs roadgaze {__version__}, the batch {task.version}; "
+            "install the same version everywhere",
+        )
+    try:
+        fingerprint = fingerprint_of(task)
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        return DriveResult.of(drive, "failed", error=f"cannot read video {drive.path}: {reason}")
+    done = find_done(task, fingerprint)
+    if done is not None:
+        return done
+    if fingerprint["input"]["size"] == 0:
+        return DriveResult.of(drive, "failed", error=f"video {drive.path} is empty (0 bytes)")
+    try:
+        return _run_drive(task, fingerprint, started)
+    except RoadgazeError as exc:
+        return DriveResult.of(drive, "failed", error=one_line(exc))
+    except Exception as exc:
+        log.exception("drive %s failed", drive.drive_id)
+        return DriveResult.of(drive, "failed", error=one_line(exc))
+
+
+def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> DriveResult:
+    from roadgaze.capture import VideoFileSource
+    from roadgaze.pipeline import Pipeline, create_detector
+
+    drive, config = task.drive, task.config
+    frames_path, alerts_path = output_paths(task.out_dir, drive.drive_id)
+    constant = {
+        "drive_id": drive.drive_id,
+        "driver_id": drive.driver_id,
+        "vehicle_id": drive.vehicle_id,
+        "start_time": drive.start_time,
+    }
+    with ExitStack() as stack:
+        source = stack.enter_context(VideoFileSource(drive.path))
+        detector = create_detector(config)
+        stack.callback(detector.close)
+        startup_s = time.perf_counter() - started
+        frames = stack.enter_context(AtomicParquetWriter(frames_path, frames_schema(), constant))
+        alerts = stack.enter_context(AtomicParquetWriter(alerts_path, alerts_schema(), constant))
+        recorder = DriveRecorder(frames, alerts)
+        summary = Pipeline.from_config(config, detector).run(source, [recorder], stop=_stop)
+        if _stop is not None and _stop.is_set():
+            return DriveResult.of(drive, "interrupted", error="stopped before the end")
+        if summary.frames == 0:
+            return DriveResult.of(drive, "failed", error=f"video {drive.path} has no frame")
+        result = recorder.result(
+            drive,
+            period_s=1.0 / source.info.fps if source.info.fps else 0.0,
+            warning=summary.source_status.message,
+            processing_fps=summary.fps,
+            startup_s=startup_s,
+        )
+        alerts.commit({"fingerprint": fingerprint})
+        result = replace(result, wall_s=round(time.perf_counter() - started, 3))
+        frames.commit({"fingerprint": fingerprint, "summary": result.to_json()})
+        return result
+
+
+@dataclass(slots=True)
+class DriveRecorder:
+    """A pipeline sink: every record to the frames table, every alert to the alerts table, and
+    the counts of the drive's summary."""
+
+    frames: AtomicParquetWriter
+    alerts: AtomicParquetWriter
+    faces: int = 0
+    known_gaze: int = 0
+    off_road: int = 0
+    first_t_s: float | None = None
+    last_t_s: float = 0.0
+    longest_off_road_s: float = 0.0
+    neutral_yaw_deg: float | None = None
+    critical: int = 0
+    counts: dict[str, int] = field(default_factory=lambda: dict.fromkeys(ALERT_KINDS, 0))
+    _active: tuple[AlertKind, ...] = ()
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self.frames.append(record_fields(record))
+        sample, verdict = record.sample, record.verdict
+        self.first_t_s = sample.t_s if self.first_t_s is None else self.first_t_s
+        self.last_t_s = sample.t_s
+        self.faces += sample.face
+        self.known_gaze += verdict.gaze is not Gaze.UNKNOWN
+        self.off_road += verdict.gaze is Gaze.OFF_ROAD
+        self.longest_off_road_s = max(self.longest_off_road_s, verdict.off_road_s)
+        self.neutral_yaw_deg = verdict.neutral_yaw_deg
+        for alert in record.alerts:
+            self.alerts.append({"frame": sample.frame, **alert_fields(alert)})
+            self.critical += alert.level is AlertLevel.CRITICAL
+            if alert.kind.value in self.counts and alert.kind not in self._active:
+                self.counts[alert.kind.value] += 1
+        self._active = verdict.active
+
+    def close(self) -> None:
+        return None
+
+    def result(
+        self,
+        drive: Drive,
+        period_s: float,
+        warning: str | None,
+        processing_fps: float,
+        startup_s: float,
+    ) -> DriveResult:
+        duration_s = self.last_t_s - (self.first_t_s or 0.0) + period_s
+        return DriveResult.of(
+            drive,
+            "ok",
+            warning=warning,
+            frames=self.frames.rows,
+            frames_with_face=self.faces,
+            frames_gaze_known=self.known_gaze,
+            frames_off_road=self.off_road,
+            duration_s=round(duration_s, 3),
+            alert_counts=tuple(self.counts.items()),
+            critical_alerts=self.critical,
+            longest_off_road_s=round(self.longest_off_road_s, 3),
+            neutral_yaw_deg=_finite_or_none(self.neutral_yaw_deg),
+            processing_fps=round(processing_fps, 2),
+            startup_s=round(startup_s, 3),
+        )
+
+
+def _finite_or_none(value: float | None) -> float | None:
+    return None if value is None or not math.isfinite(value) else round(value, 3)

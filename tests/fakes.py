@@ -177,3 +177,15 @@ def record_of(
         config = MonitorConfig()
         verdict = verdict_of(config, initial_state(config))
     return FrameRecord(sample=sample, verdict=verdict, alerts=alerts)
+
+
+def die_on_crash_drives(task: Any) -> Any:
+    """A fleet task function for worker processes: the process dies on drives named `crash*`
+    (as on a crash in native code); other drives succeed at once with one frame."""
+    import os
+
+    from roadgaze.fleet import DriveResult
+
+    if task.drive.drive_id.startswith("crash"):
+        os._exit(70)
+    return DriveResult.of(task.drive, "ok", frames=1, duration_s=0.1)

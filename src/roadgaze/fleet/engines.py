@@ -59,7 +59,7 @@ def available_cores() -> int:
         return os.cpu_count() or 1
 
 
-def _init_worker(stop: Any, log_path: str) -> None:
+def _init_worker(stop: Any, log_path: str, warm_up: bool) -> None:
     """In each worker: Ctrl-C is the parent's business, output goes to the batch log."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     descriptor = os.open(log_path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
@@ -73,9 +73,9 @@ def _init_worker(stop: Any, log_path: str) -> None:
         force=True,
     )
     use_stop_signal(stop)
-    # Imported once per worker here, so a drive's start-up is its own (video, landmarker).
-    import cv2  # noqa: F401
-    from mediapipe.tasks.python import vision  # noqa: F401
+    if warm_up:  # imported once per worker here, so a drive's start-up is its own
+        import cv2  # noqa: F401
+        from mediapipe.tasks.python import vision  # noqa: F401
 
 
 class LocalEngine:
@@ -120,7 +120,11 @@ class LocalEngine:
                 max_workers=self.workers,
                 mp_context=self._context,
                 initializer=_init_worker,
-                initargs=(self._worker_stop, str(self._log_path)),
+                initargs=(
+                    self._worker_stop,
+                    str(self._log_path),
+                    self.function is process_drive,
+                ),
             )
         return self._executor
 

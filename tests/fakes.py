@@ -169,6 +169,18 @@ BLANK_FRAME = Frame(0, 0.0, np.zeros((4, 4, 3), np.uint8))
 """A frame for sinks that ignore the image."""
 
 
+FACE = FaceFeatures(
+    x_left_px=100.0,
+    x_right_px=180.0,
+    x_center_px=150.0,
+    roll_deg=10.0,
+    box_px=(95.0, 60.0, 185.0, 170.0),
+    quality=0.9,
+    landmarks_px=np.array([[100, 100, 0], [180, 110, 0], [150, 160, 0]], np.float32),
+)
+"""A face 80 px wide with its centre right of the middle (for writer and record tests)."""
+
+
 def record_of(
     sample: PoseSample, verdict: Verdict | None = None, alerts: tuple[Alert, ...] = ()
 ) -> FrameRecord:

@@ -5,10 +5,9 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
 import pytest
 
-from fakes import record_of
+from fakes import FACE, record_of
 from roadgaze.outputs import (
     ALERT_SCHEMA,
     RECORD_FIELDS,
@@ -18,17 +17,8 @@ from roadgaze.outputs import (
     record_fields,
 )
 from roadgaze.transport import AlertMessage
-from roadgaze.types import Alert, AlertKind, AlertLevel, FaceFeatures, PoseSample
+from roadgaze.types import Alert, AlertKind, AlertLevel, PoseSample
 
-FACE = FaceFeatures(
-    x_left_px=100.0,
-    x_right_px=180.0,
-    x_center_px=150.0,
-    roll_deg=10.0,
-    box_px=(95.0, 60.0, 185.0, 170.0),
-    quality=0.9,
-    landmarks_px=np.zeros((3, 3), np.float32),
-)
 ALERTS = (
     Alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING, 0.5, 19.5, 3.0, 3.0),
     Alert(

@@ -116,7 +116,8 @@ def report(outcome: BatchOutcome, out_dir: Path) -> None:
         f"batch: {figures['ok']} of {figures['drives']} drives ok ({figures['processed']} "
         f"processed, {figures['resumed']} kept from an earlier run), {figures['failed']} failed; "
         f"{figures['frames']} frames in {outcome.wall_s:.1f} s = {outcome.frames_per_s:.1f} "
-        f"frames/s on {outcome.engine} with {outcome.workers} workers",
+        f"frames/s on {outcome.engine} with {outcome.workers} "
+        f"worker{'' if outcome.workers == 1 else 's'}",
         file=sys.stderr,
     )
     for result in outcome.failed[:FAILED_LISTED]:

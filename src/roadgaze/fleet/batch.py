@@ -84,7 +84,9 @@ def pinned_model(config: Config) -> Config:
 
 def make_engine(options: BatchOptions) -> Engine:
     if options.engine == "ray":
-        return RayEngine(options.ray_address, options.workers, options.retries)
+        return RayEngine(
+            options.out_dir / LOG_NAME, options.ray_address, options.workers, options.retries
+        )
     return LocalEngine(options.out_dir / LOG_NAME, options.workers, options.retries)
 
 

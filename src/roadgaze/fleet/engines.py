@@ -16,15 +16,17 @@ import multiprocessing
 import os
 import signal
 import sys
+import time
 from collections import Counter, deque
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from pathlib import Path
 from types import TracebackType
 from typing import Any, Protocol
 
-from roadgaze.errors import ConfigError
+from roadgaze.errors import ConfigError, RoadgazeError
 from roadgaze.fleet.task import DriveResult, DriveTask, one_line, process_drive, use_stop_signal
 from roadgaze.pipeline import StopSignal
 
@@ -78,6 +80,12 @@ def _init_worker(stop: Any, log_path: str, warm_up: bool) -> None:
         from mediapipe.tasks.python import vision  # noqa: F401
 
 
+def _worker_pid() -> int:
+    """A warm-up call: which worker answered (after a moment, so the others get calls too)."""
+    time.sleep(0.05)
+    return os.getpid()
+
+
 class LocalEngine:
     """A pool of `workers` spawned processes on this machine (default: one per core).
 
@@ -103,7 +111,24 @@ class LocalEngine:
 
     def __enter__(self) -> LocalEngine:
         self._worker_stop = self._context.Event()
+        self._warm_up()
         return self
+
+    def _warm_up(self, timeout_s: float = 120.0) -> None:
+        """Start every worker process now (spawn, imports), so that start-up is not counted
+        against the first drives; gives up quietly after `timeout_s`."""
+        executor = self._open_executor()
+        ready: set[int] = set()
+        deadline = time.monotonic() + timeout_s
+        while len(ready) < self.workers and time.monotonic() < deadline:
+            calls = [executor.submit(_worker_pid) for _ in range(self.workers)]
+            try:
+                ready.update(call.result() for call in calls)
+            except BrokenProcessPool:
+                self._close_executor()
+                raise RoadgazeError(
+                    f"the batch's worker processes cannot start; see {self._log_path}"
+                ) from None
 
     def __exit__(
         self,
@@ -178,6 +203,23 @@ class LocalEngine:
             yield DriveResult.of(task.drive, "pending")
 
 
+@contextmanager
+def stderr_to(path: Path) -> Iterator[None]:
+    """Within the block, everything written to file descriptor 2 (native code included) is
+    appended to `path` instead of the terminal."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
+    os.dup2(descriptor, 2)
+    os.close(descriptor)
+    try:
+        yield
+    finally:
+        sys.stderr.flush()
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
 def import_ray() -> Any:
     """The `ray` module; ConfigError saying how to install it when it is missing."""
     try:
@@ -191,28 +233,36 @@ class RayEngine:
     """The same task function as Ray tasks (`num_cpus=1`, retried `retries` times when a worker
     dies) on the cluster at `address`, else `RAY_ADDRESS`, else a local Ray instance.
 
-    Ray's logs stay off the terminal. A Ray already initialised by the caller is used as it is
-    and left running. Outputs are written by the workers: on a cluster the output folder must
-    be the same shared path on every node.
+    Ray's logs stay off the terminal: workers' output is not sent to the driver, and what Ray's
+    native code prints while connecting goes to `log_path`. A Ray already initialised by the
+    caller is used as it is and left running. Outputs are written by the workers: on a cluster
+    the output folder must be the same shared path on every node.
     """
 
     def __init__(
-        self, address: str | None = None, workers: int | None = None, retries: int = 2
+        self,
+        log_path: Path,
+        address: str | None = None,
+        workers: int | None = None,
+        retries: int = 2,
     ) -> None:
         self.address = address
+        self._log_path = log_path
         self.workers = workers or 0
         self.retries = retries
         self._ray: Any = None
         self._started_here = False
 
     def __enter__(self) -> RayEngine:
+        os.environ.setdefault("RAY_BACKEND_LOG_LEVEL", "error")  # before Ray's core loads
         ray = self._ray = import_ray()
         if not ray.is_initialized():
             options: dict[str, Any] = {"log_to_driver": False, "logging_level": logging.ERROR}
             if self.address is None and not os.environ.get("RAY_ADDRESS"):
                 options["include_dashboard"] = False
             try:
-                ray.init(address=self.address, **options)
+                with stderr_to(self._log_path):
+                    ray.init(address=self.address, **options)
             except (ConnectionError, ValueError, RuntimeError) as exc:
                 where = self.address or os.environ.get("RAY_ADDRESS") or "a local instance"
                 raise ConfigError(

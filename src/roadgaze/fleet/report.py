@@ -141,7 +141,8 @@ def _totals(fleet: GroupStats, outcome: BatchOutcome) -> str:
         f"This run: {len(outcome.processed):,} drives processed, "
         f"{outcome.count('ok', resumed=True):,} kept from an earlier run, "
         f"{outcome.frames_processed:,} frames in {outcome.wall_s:,.1f} s on the "
-        f"{escape(outcome.engine)} engine with {outcome.workers} workers."
+        f"{escape(outcome.engine)} engine with {outcome.workers} worker"
+        f"{'' if outcome.workers == 1 else 's'}."
     )
     if outcome.interrupted:
         run += ' <b class="bad">The run was stopped before its end; run it again to continue.</b>'

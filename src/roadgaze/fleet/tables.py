@@ -12,9 +12,9 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -172,31 +172,26 @@ def read_drive_metadata(path: Path) -> dict[str, Any] | None:
     return value if isinstance(value, dict) else None
 
 
-def write_table_atomically(path: Path, table: Any) -> None:
-    """A whole table written to `path` by way of a temporary file."""
+def write_atomically(path: Path, write: Callable[[BinaryIO], object]) -> None:
+    """`write(handle)` into a temporary file beside `path`, synced, then renamed to `path`."""
     path.parent.mkdir(parents=True, exist_ok=True)
     temporary = temporary_path(path)
     try:
         with temporary.open("wb") as handle:
-            pq.write_table(table, handle, compression="zstd")
+            write(handle)
             handle.flush()
             os.fsync(handle.fileno())
         temporary.replace(path)
     finally:
         temporary.unlink(missing_ok=True)
     fsync_folder(path.parent)
+
+
+def write_table_atomically(path: Path, table: Any) -> None:
+    """A whole Parquet table written to `path` atomically."""
+    write_atomically(path, lambda handle: pq.write_table(table, handle, compression="zstd"))
 
 
 def write_text_atomically(path: Path, text: str) -> None:
-    """A text file written to `path` by way of a temporary file."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = temporary_path(path)
-    try:
-        with temporary.open("w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        temporary.replace(path)
-    finally:
-        temporary.unlink(missing_ok=True)
-    fsync_folder(path.parent)
+    """A UTF-8 text file written to `path` atomically."""
+    write_atomically(path, lambda handle: handle.write(text.encode("utf-8")))

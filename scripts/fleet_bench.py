@@ -11,8 +11,10 @@ corrupt file, a truncated copy of a drive and a missing path to the manifest.
 
 `throughput` runs `roadgaze batch VIDEOS --workers N --json` for each N in turn, `--repeats`
 times, each into a fresh output folder, interleaved so that other load on the machine falls on
-both alike; prints the frames/s of each run, the 2-over-1 ratio of each repeat, and the time to
-create one VIDEO-mode landmarker (the per-file start-up besides opening the video).
+both alike; prints the frames/s of each run, the CPU time it used (all processes; frames per
+CPU-second shows what parallel work costs besides the cores it gets), the 2-over-1 ratio of each
+repeat, and the time to create one VIDEO-mode landmarker (the per-file start-up besides opening
+the video).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import argparse
 import csv
 import json
 import random
+import resource
 import statistics
 import subprocess
 import sys
@@ -112,20 +115,25 @@ def throughput(args: argparse.Namespace) -> int:
                 out = Path(scratch) / f"out-{repeat}-{workers}"
                 command = [sys.executable, "-m", "roadgaze", "batch", str(args.videos)]
                 command += ["--out", str(out), "--workers", str(workers), "--json"]
+                before = resource.getrusage(resource.RUSAGE_CHILDREN)
                 result = subprocess.run(
                     [*command, "--no-progress"], capture_output=True, text=True, check=False
                 )
+                after = resource.getrusage(resource.RUSAGE_CHILDREN)
+                cpu_s = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
                 if result.returncode not in (0, 3):
                     print(result.stderr, file=sys.stderr)
                     return result.returncode
                 figures = json.loads(result.stdout)
                 figures["repeat"] = repeat + 1
+                figures["cpu_s"] = round(cpu_s, 2)
                 runs.append(figures)
                 print(
                     f"repeat {repeat + 1}, {workers} worker(s): {figures['frames']} frames in "
                     f"{figures['wall_s']:.1f} s = {figures['frames_per_s']:.1f} frames/s "
                     f"(pool start {figures['engine_startup_s']:.1f} s, per-drive start-up "
-                    f"median {figures['drive_startup_median_s']} s)",
+                    f"median {figures['drive_startup_median_s']} s; {cpu_s:.1f} CPU-s in all, "
+                    f"{figures['frames'] / cpu_s:.1f} frames per CPU-second)",
                     flush=True,
                 )
     by_key = {(r["repeat"], r["workers"]): r["frames_per_s"] for r in runs}

@@ -144,3 +144,12 @@ def test_the_recorder_counts_an_escalated_alert_once(tmp_path: Path) -> None:
     assert result.longest_off_road_s == 6.0
     assert result.neutral_yaw_deg == 1.5
     assert result.off_road_ratio == pytest.approx(2 / 3)  # two off road of three with gaze known
+
+
+def test_a_missing_video_is_a_failed_drive_with_one_line(tmp_path: Path) -> None:
+    from roadgaze.config import Config
+    from roadgaze.fleet import DriveTask, process_drive
+
+    result = process_drive(DriveTask(Drive("gone", tmp_path / "gone.mp4"), tmp_path, Config()))
+    assert (result.status, result.error) == ("failed", f"video file {tmp_path}/gone.mp4 not found")
+    assert not (tmp_path / "frames").exists()

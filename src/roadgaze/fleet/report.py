@@ -28,7 +28,7 @@ table{border-collapse:collapse;font-size:13px}td,th{padding:3px 8px;border-botto
 th{text-align:left;background:#f4f4f4;position:sticky;top:0}td.n{text-align:right}
 .cards{display:flex;flex-wrap:wrap;gap:12px}.card{border:1px solid #ddd;border-radius:6px;
 padding:8px 14px;min-width:130px}.card b{display:block;font-size:1.5em}.bad{color:#b00}
-img{max-width:100%;margin:8px 0}.note{color:#666}
+td:first-child{white-space:nowrap}img{max-width:100%;margin:8px 0}.note{color:#666}
 """
 
 
@@ -42,6 +42,10 @@ def _number(value: float | int | None, digits: int = 1, suffix: str = "") -> str
 
 def _percent(value: float | None) -> str:
     return "-" if value is None else f"{100.0 * value:.1f}%"
+
+
+def _hours(hours: float) -> str:
+    return f"{hours:,.2f} h" if hours >= 1.0 else f"{hours * 60.0:.1f} min"
 
 
 def _kind_title(kind: str) -> str:
@@ -103,6 +107,7 @@ def _plots(ok: Sequence[DriveResult], drivers: Sequence[GroupStats]) -> str:
         axes.hist(ratios, bins=20, range=(0, 100), color="#c76")
         axes.set_xlabel("off-road share of the drive (%)")
         axes.set_ylabel("drives")
+        axes.yaxis.get_major_locator().set_params(integer=True)
         axes.set_title("Off-road ratio per drive")
 
     def longest(axes: Any) -> None:
@@ -112,6 +117,7 @@ def _plots(ok: Sequence[DriveResult], drivers: Sequence[GroupStats]) -> str:
             axes.text(threshold, axes.get_ylim()[1] * 0.9, f" {label}", color="#b00")
         axes.set_xlabel("longest continuous off-road episode (s)")
         axes.set_ylabel("drives")
+        axes.yaxis.get_major_locator().set_params(integer=True)
         axes.set_title("Longest off-road episode per drive")
 
     height = max(2.5, 0.28 * len(shown) + 1.2)
@@ -122,7 +128,7 @@ def _totals(fleet: GroupStats, outcome: BatchOutcome) -> str:
     cards = [
         ("drives", f"{fleet.drives_ok:,} ok of {fleet.drives:,}"),
         ("failed", f"{fleet.drives_failed:,}"),
-        ("video", f"{fleet.hours:,.2f} h"),
+        ("video", _hours(fleet.hours)),
         ("frames", f"{fleet.frames:,}"),
         ("face found", _percent(fleet.face_found_rate)),
         ("off road", _percent(fleet.off_road_ratio)),
@@ -168,7 +174,7 @@ def _drivers(drivers: Sequence[GroupStats]) -> str:
         "driver",
         "drives",
         "failed",
-        "hours",
+        "video",
         "face found",
         "off road",
         *(f"{_kind_title(kind)} /h" for kind in ALERT_KINDS),
@@ -181,7 +187,7 @@ def _drivers(drivers: Sequence[GroupStats]) -> str:
             escape(d.name),
             _number(d.drives),
             _number(d.drives_failed),
-            _number(d.hours, 2),
+            _hours(d.hours),
             _percent(d.face_found_rate),
             _percent(d.off_road_ratio),
             *(_number(d.alerts_per_h[kind], 2) for kind in ALERT_KINDS),

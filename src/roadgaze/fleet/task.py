@@ -228,6 +228,8 @@ def process_drive(task: DriveTask) -> DriveResult:
         )
     try:
         fingerprint = fingerprint_of(task)
+    except FileNotFoundError:
+        return DriveResult.of(drive, "failed", error=f"video file {drive.path} not found")
     except OSError as exc:
         reason = exc.strerror or str(exc)
         return DriveResult.of(drive, "failed", error=f"cannot read video {drive.path}: {reason}")

@@ -82,16 +82,16 @@ def run_daemon(
             stack.enter_context(signal_handlers(stop))
         bus = stack.enter_context(bus_outputs(config, source_spec, publish=True))
         health = bus.health
+        # The model loads before the camera opens, so no frame waits for MediaPipe.
+        detector = stack.enter_context(closing(create_detector(config)))
+        source = stack.enter_context(capture.open_source(source_spec, config, wait_for_camera=True))
+        health.source = source
         log.info(
             "roadgaze run: source %s, vehicle %s, prefix %s",
             source_spec,
             health.keys.vehicle_id,
             health.keys.prefix,
         )
-        # The model loads before the camera opens, so no frame waits for MediaPipe.
-        detector = stack.enter_context(closing(create_detector(config)))
-        source = stack.enter_context(capture.open_source(source_spec, config, wait_for_camera=True))
-        health.source = source
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         pipeline.run(source, bus.sinks, realtime=realtime and not source.info.live, stop=stop)
         health.status = "stopping"

@@ -153,3 +153,23 @@ def test_a_missing_video_is_a_failed_drive_with_one_line(tmp_path: Path) -> None
     result = process_drive(DriveTask(Drive("gone", tmp_path / "gone.mp4"), tmp_path, Config()))
     assert (result.status, result.error) == ("failed", f"video file {tmp_path}/gone.mp4 not found")
     assert not (tmp_path / "frames").exists()
+
+
+def test_fingerprints_match_on_size_and_mtime_or_on_the_content_hash() -> None:
+    from roadgaze.fleet.task import fingerprints_match
+
+    def print_of(size: int = 10, mtime_ns: int = 1, sha256: str | None = None) -> dict[str, object]:
+        source: dict[str, object] = {"size": size, "mtime_ns": mtime_ns}
+        if sha256 is not None:
+            source["sha256"] = sha256
+        return {"input": source, "version": "0.1.0", "config": "c", "drive": [None, None, None]}
+
+    assert fingerprints_match(print_of(), print_of(), content_hash=False)
+    assert not fingerprints_match(print_of(mtime_ns=2), print_of(), content_hash=False)
+    assert not fingerprints_match(print_of(size=11), print_of(), content_hash=False)
+    copied = print_of(mtime_ns=2, sha256="ab")  # a copy: new mtime, same content
+    assert fingerprints_match(copied, print_of(sha256="ab"), content_hash=True)
+    assert not fingerprints_match(copied, print_of(sha256="cd"), content_hash=True)
+    assert not fingerprints_match(print_of(), print_of(sha256="ab"), content_hash=True)
+    assert not fingerprints_match({**print_of(), "config": "d"}, print_of(), content_hash=False)
+    assert not fingerprints_match(None, print_of(), content_hash=False)

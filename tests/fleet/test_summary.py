@@ -48,6 +48,7 @@ RESULTS = (
         critical_alerts=1,
         longest_off_road_s=7.25,
         neutral_yaw_deg=-4.0,
+        processing_fps=45.0,
         resumed=True,
     ),
     ok("b1", None, duration_s=120.0, frames=3600, frames_with_face=3600, frames_gaze_known=3600),
@@ -65,7 +66,7 @@ def test_group_figures_are_weighted_by_frames_and_time() -> None:
     assert alice.alerts_per_h["long_distraction"] == pytest.approx(3 * 3600 / 90)
     assert alice.longest_off_road_s == 7.25
     assert alice.neutral_yaw_deg == pytest.approx(-1.0)
-    assert alice.processing_fps == pytest.approx(90.0)  # the resumed drive was not timed
+    assert alice.processing_fps == pytest.approx(2700 / (1800 / 90 + 900 / 45))
     assert alice.critical_alerts == 1
 
 
@@ -85,7 +86,7 @@ def test_summary_rows_per_drive_with_rates_per_hour_and_nulls_for_failures() -> 
     assert a2["face_found_rate"] == 0.5 and a2["off_road_ratio"] == 0.5
     assert a2["long_distraction_per_h"] == 240.0 and a2["vats_per_h"] == 120.0
     assert a2["alerts_driver_unavailable"] == 1
-    assert a2["processing_fps"] is None  # not processed in this run
+    assert a2["processing_fps"] == 45.0  # as measured by the run that processed it
     bad = rows[3]
     assert (bad["status"], bad["error"], bad["frames"], bad["duration_s"]) == (
         "failed",

@@ -137,7 +137,7 @@ def _totals(fleet: GroupStats, outcome: BatchOutcome) -> str:
             for kind in ALERT_KINDS
         ),
         ("longest off road", _number(fleet.longest_off_road_s, 1, " s")),
-        ("processing", f"{outcome.frames_per_s:,.0f} frames/s"),
+        ("loop speed per worker", _number(fleet.processing_fps, 0, " frames/s")),
     ]
     html = "".join(
         f'<div class="card">{escape(label)}<b>{escape(value)}</b></div>' for label, value in cards
@@ -146,7 +146,8 @@ def _totals(fleet: GroupStats, outcome: BatchOutcome) -> str:
     run = (
         f"This run: {len(outcome.processed):,} drives processed, "
         f"{outcome.count('ok', resumed=True):,} kept from an earlier run, "
-        f"{outcome.frames_processed:,} frames in {outcome.wall_s:,.1f} s on the "
+        f"{outcome.frames_processed:,} frames in {outcome.wall_s:,.1f} s "
+        f"({outcome.frames_per_s:,.1f} frames/s) on the "
         f"{escape(outcome.engine)} engine with {outcome.workers} worker"
         f"{'' if outcome.workers == 1 else 's'}."
     )
@@ -234,7 +235,7 @@ def _drives(ok: Sequence[DriveResult]) -> str:
                 *(_number(per_hour(counts.get(k, 0), r.duration_s), 1) for k in ALERT_KINDS),
                 _number(r.longest_off_road_s),
                 _number(r.neutral_yaw_deg),
-                "-" if r.resumed else _number(r.processing_fps, 0),
+                _number(r.processing_fps, 0),
             ]
         )
     more = len(ordered) - MAX_DRIVE_ROWS

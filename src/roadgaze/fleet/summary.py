@@ -77,9 +77,9 @@ def summary_row(result: DriveResult) -> dict[str, Any]:
         "critical_alerts": result.critical_alerts if ok else None,
         "longest_off_road_s": result.longest_off_road_s if ok else None,
         "neutral_yaw_deg": result.neutral_yaw_deg if ok else None,
-        "processing_fps": result.processing_fps if ok and not result.resumed else None,
-        "startup_s": result.startup_s if ok and not result.resumed else None,
-        "wall_s": result.wall_s if ok and not result.resumed else None,
+        "processing_fps": result.processing_fps if ok else None,
+        "startup_s": result.startup_s if ok else None,
+        "wall_s": result.wall_s if ok else None,
     }
     for kind in ALERT_KINDS:
         row[f"alerts_{kind}"] = counts.get(kind, 0) if ok else None
@@ -116,7 +116,8 @@ class GroupStats:
     neutral_yaw_deg: float | None
     """Mean over the group's drives of the road-ahead yaw learned by the end of each."""
     processing_fps: float | None
-    """Frames over the summed per-drive loop time, for drives processed in this run."""
+    """Frames over the summed per-drive loop time: the speed of one worker's loop (a resumed
+    drive counts with the speed of the run that processed it)."""
 
 
 def group_stats(name: str, results: Sequence[DriveResult]) -> GroupStats:
@@ -127,7 +128,7 @@ def group_stats(name: str, results: Sequence[DriveResult]) -> GroupStats:
     known = sum(r.frames_gaze_known for r in ok)
     alerts = {kind: sum(dict(r.alert_counts).get(kind, 0) for r in ok) for kind in ALERT_KINDS}
     neutrals = [r.neutral_yaw_deg for r in ok if r.neutral_yaw_deg is not None]
-    timed = [r for r in ok if not r.resumed and r.processing_fps > 0]
+    timed = [r for r in ok if r.processing_fps > 0]
     loop_s = sum(r.frames / r.processing_fps for r in timed)
     return GroupStats(
         name=name,

@@ -25,7 +25,7 @@ _STYLE = """
 body{font:14px/1.4 system-ui,sans-serif;margin:2em auto;max-width:1200px;color:#222;padding:0 1em}
 h1{font-size:1.6em}h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #ccc}
 table{border-collapse:collapse;font-size:13px}td,th{padding:3px 8px;border-bottom:1px solid #eee}
-th{text-align:left;background:#f4f4f4;position:sticky;top:0}td.n{text-align:right}
+th{text-align:left;background:#f4f4f4;position:sticky;top:0}td.n{text-align:right;white-space:nowrap}
 .cards{display:flex;flex-wrap:wrap;gap:12px}.card{border:1px solid #ddd;border-radius:6px;
 padding:8px 14px;min-width:130px}.card b{display:block;font-size:1.5em}.bad{color:#b00}
 td:first-child{white-space:nowrap}img{max-width:100%;margin:8px 0}.note{color:#666}

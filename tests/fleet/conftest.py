@@ -10,8 +10,8 @@ from typing import Any
 import pytest
 
 TIMELINES = {
-    "glance.mkv": "0:1,45:4,0:1",  # a long distraction, then cleared
-    "right.mkv": "0:1,-35:1.5,0:1",
+    "glance.mkv": "0:1,-35:4.5,0:1",  # away to the right: a long distraction, then cleared
+    "right.mkv": "0:1,45:1.5,0:1",  # a glance to the left mirror: no alert
     "trip/road.mkv": "0:2",
 }
 """Synthetic drives (relative path -> timeline), 320x320 at 15 fps."""

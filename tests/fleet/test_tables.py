@@ -13,6 +13,7 @@ import pytest
 from fakes import record_of
 from roadgaze.config import MonitorConfig
 from roadgaze.fleet.drives import Drive
+from roadgaze.fleet.recorder import DriveRecorder
 from roadgaze.fleet.tables import (
     AtomicParquetWriter,
     alerts_schema,
@@ -21,7 +22,6 @@ from roadgaze.fleet.tables import (
     remove_temporary_files,
     temporary_path,
 )
-from roadgaze.fleet.task import DriveRecorder
 from roadgaze.monitor import initial_state, verdict_of
 from roadgaze.outputs import records
 from roadgaze.outputs.records import RECORD_FIELDS, FieldType
@@ -43,15 +43,15 @@ def test_the_frames_schema_is_the_drive_metadata_then_every_record_field() -> No
 def test_a_field_added_to_the_typed_record_appears_in_parquet(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    extended = (*records.RECORD_SCHEMA, ("pitch_deg", FieldType.FLOAT))
+    extended = (*records.RECORD_SCHEMA, ("eyes_closed_s", FieldType.FLOAT))
     monkeypatch.setattr(records, "RECORD_SCHEMA", extended)
     path = tmp_path / "frames.parquet"
     with AtomicParquetWriter(path, frames_schema(), CONSTANT) as writer:
-        writer.append({"t_s": 0.0, "frame": 0, "pitch_deg": -4.5})
+        writer.append({"t_s": 0.0, "frame": 0, "eyes_closed_s": 0.5})
         writer.commit({})
     table = pq.read_table(path)
-    assert table.schema.field("pitch_deg").type == pa.float64()
-    assert table.column("pitch_deg").to_pylist() == [-4.5]
+    assert table.schema.field("eyes_closed_s").type == pa.float64()
+    assert table.column("eyes_closed_s").to_pylist() == [0.5]
 
 
 def test_alerts_schema_has_every_alert_field_and_the_frame() -> None:
@@ -173,3 +173,22 @@ def test_fingerprints_match_on_size_and_mtime_or_on_the_content_hash() -> None:
     assert not fingerprints_match(print_of(), print_of(sha256="ab"), content_hash=True)
     assert not fingerprints_match({**print_of(), "config": "d"}, print_of(), content_hash=False)
     assert not fingerprints_match(None, print_of(), content_hash=False)
+
+
+def test_columns_known_only_at_the_end_are_filled_row_group_by_row_group(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr("roadgaze.fleet.tables.ROWS_PER_BATCH", 3)
+    path = tmp_path / "d1.parquet"
+    with AtomicParquetWriter(path, frames_schema(), CONSTANT) as writer:
+        for index in range(7):
+            writer.append({"t_s": index / 10, "frame": index, "yaw_raw_deg": 2.0 * index})
+        offline = [None, *(0.5 * index for index in range(1, 7))]
+        writer.commit({"fingerprint": {"size": 7}}, {"yaw_offline_deg": offline})
+    table = pq.read_table(path)
+    assert table.column("yaw_offline_deg").to_pylist() == offline
+    assert table.column("yaw_raw_deg").to_pylist() == [2.0 * index for index in range(7)]
+    assert table.schema.remove_metadata().equals(frames_schema())
+    assert pq.ParquetFile(path).metadata.num_row_groups == 3
+    assert read_drive_metadata(path) == {"fingerprint": {"size": 7}}
+    assert [p.name for p in tmp_path.iterdir()] == ["d1.parquet"]

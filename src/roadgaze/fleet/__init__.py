@@ -10,17 +10,21 @@ from roadgaze.fleet.drives import (
     read_manifest,
 )
 from roadgaze.fleet.engines import LocalEngine, RayEngine, available_cores
+from roadgaze.fleet.recorder import DriveRecorder
 from roadgaze.fleet.report import render_report
+from roadgaze.fleet.results import ALERT_KINDS, DriveResult
 from roadgaze.fleet.summary import BatchOutcome, GroupStats, by_driver, group_stats, summary_table
 from roadgaze.fleet.tables import alerts_schema, frames_schema
-from roadgaze.fleet.task import DriveResult, DriveTask, find_done, output_paths, process_drive
+from roadgaze.fleet.task import DriveTask, find_done, output_paths, process_drive
 
 __all__ = [
+    "ALERT_KINDS",
     "MANIFEST_COLUMNS",
     "VIDEO_SUFFIXES",
     "BatchOptions",
     "BatchOutcome",
     "Drive",
+    "DriveRecorder",
     "DriveResult",
     "DriveTask",
     "GroupStats",

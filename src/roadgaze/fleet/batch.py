@@ -22,13 +22,14 @@ from roadgaze.errors import ConfigError
 from roadgaze.fleet.drives import Drive
 from roadgaze.fleet.engines import Engine, LocalEngine, RayEngine
 from roadgaze.fleet.report import render_report
+from roadgaze.fleet.results import DriveResult
 from roadgaze.fleet.summary import BatchOutcome, summary_table
 from roadgaze.fleet.tables import (
     remove_temporary_files,
     write_table_atomically,
     write_text_atomically,
 )
-from roadgaze.fleet.task import DriveResult, DriveTask, find_done
+from roadgaze.fleet.task import DriveTask, find_done
 from roadgaze.signals import StopFlag, signal_handlers
 
 SUMMARY_NAME = "summary.parquet"

@@ -27,7 +27,8 @@ from types import TracebackType
 from typing import Any, Protocol
 
 from roadgaze.errors import ConfigError, RoadgazeError
-from roadgaze.fleet.task import DriveResult, DriveTask, one_line, process_drive, use_stop_signal
+from roadgaze.fleet.results import DriveResult
+from roadgaze.fleet.task import DriveTask, one_line, process_drive, use_stop_signal
 from roadgaze.pipeline import StopSignal
 
 POLL_S = 0.2

@@ -15,8 +15,8 @@ from html import escape
 from typing import Any
 
 from roadgaze import __version__
+from roadgaze.fleet.results import ALERT_KINDS, DriveResult
 from roadgaze.fleet.summary import BatchOutcome, GroupStats, by_driver, group_stats, per_hour
-from roadgaze.fleet.task import ALERT_KINDS, DriveResult
 
 MAX_DRIVE_ROWS = 2000
 """Per-drive rows shown in the report (every drive is in summary.parquet)."""

@@ -16,7 +16,7 @@ from typing import Any
 
 import pyarrow as pa
 
-from roadgaze.fleet.task import ALERT_KINDS, DriveResult
+from roadgaze.fleet.results import ALERT_KINDS, DriveResult
 
 UNKNOWN_DRIVER = "(unknown)"
 """How drives without a `driver_id` are grouped."""

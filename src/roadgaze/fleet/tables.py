@@ -12,7 +12,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -132,16 +132,39 @@ class AtomicParquetWriter:
             self._columns = {name: [] for name in self._columns}
             self._buffered = 0
 
-    def commit(self, metadata: dict[str, Any]) -> None:
-        """Write the rest, store `metadata` (JSON) under `METADATA_KEY`, sync and rename."""
+    def commit(
+        self, metadata: dict[str, Any], filled: Mapping[str, Sequence[float | None]] | None = None
+    ) -> None:
+        """Write the rest, store `metadata` (JSON) under `METADATA_KEY`, sync and rename.
+
+        `filled` gives columns known only at the end (one value per row, e.g. the offline pass):
+        the streamed file is then copied row group by row group with those columns replaced,
+        so memory stays bounded by one row group.
+        """
         self._flush()
-        self._writer.add_key_value_metadata({METADATA_KEY: json.dumps(metadata).encode()})
-        self._writer.close()
-        self._writer = None
-        self._file.flush()
-        os.fsync(self._file.fileno())
-        self._file.close()
-        self._temporary.replace(self.path)
+        key_value = {METADATA_KEY: json.dumps(metadata).encode()}
+        if filled:
+            self._writer.close()
+            self._writer = None
+            self._file.close()
+            final = self._temporary.with_name(self._temporary.name + ".filled" + TEMPORARY_SUFFIX)
+            try:
+                with final.open("wb") as handle:
+                    _copy_filled(self._temporary, handle, self._schema, filled, key_value)
+                    handle.flush()
+                    os.fsync(handle.fileno())
+                final.replace(self.path)
+            finally:
+                final.unlink(missing_ok=True)
+                self._temporary.unlink(missing_ok=True)
+        else:
+            self._writer.add_key_value_metadata(key_value)
+            self._writer.close()
+            self._writer = None
+            self._file.flush()
+            os.fsync(self._file.fileno())
+            self._file.close()
+            self._temporary.replace(self.path)
         fsync_folder(self.path.parent)
 
     def discard(self) -> None:
@@ -159,6 +182,32 @@ class AtomicParquetWriter:
 
     def __exit__(self, *exc_info: object) -> None:
         self.discard()
+
+
+def _copy_filled(
+    source: Path,
+    handle: BinaryIO,
+    schema: Any,
+    filled: Mapping[str, Sequence[float | None]],
+    key_value: dict[bytes, bytes],
+) -> None:
+    """`source` written to `handle` with the `filled` columns replaced, one row group at a time."""
+    streamed = pq.ParquetFile(source)
+    writer = pq.ParquetWriter(handle, schema, compression="zstd")
+    try:
+        start = 0
+        for group in range(streamed.num_row_groups):
+            table = streamed.read_row_group(group)
+            end = start + table.num_rows
+            for name, values in filled.items():
+                index = schema.get_field_index(name)
+                column = pa.array(values[start:end], type=schema.field(name).type)
+                table = table.set_column(index, schema.field(name), column)
+            writer.write_table(table)
+            start = end
+        writer.add_key_value_metadata(key_value)
+    finally:
+        writer.close()
 
 
 def read_drive_metadata(path: Path) -> dict[str, Any] | None:

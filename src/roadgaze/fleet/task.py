@@ -14,35 +14,27 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import math
 import time
 from contextlib import ExitStack
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 from roadgaze import __version__
 from roadgaze.config import Config
 from roadgaze.errors import RoadgazeError
 from roadgaze.fleet.drives import Drive
+from roadgaze.fleet.recorder import DriveRecorder
+from roadgaze.fleet.results import DriveResult
 from roadgaze.fleet.tables import (
     AtomicParquetWriter,
     alerts_schema,
     frames_schema,
     read_drive_metadata,
 )
-from roadgaze.outputs.records import alert_fields, record_fields
 from roadgaze.pipeline import StopSignal
-from roadgaze.types import AlertKind, AlertLevel, Frame, FrameRecord, Gaze
 
 log = logging.getLogger(__name__)
-
-Status = Literal["ok", "failed", "interrupted", "pending"]
-"""ok: outputs written (now or by an earlier run); failed: see `error`; interrupted: stopped
-before its end, nothing written; pending: not started before the batch was stopped."""
-
-ALERT_KINDS = tuple(kind.value for kind in AlertKind if kind is not AlertKind.CLEARED)
-"""The kinds counted per drive (`cleared` ends alerts; it is not one)."""
 
 HASH_CHUNK_BYTES = 1 << 20
 
@@ -58,74 +50,6 @@ class DriveTask:
     """Fingerprint the input by its SHA-256 instead of its size and modification time."""
     version: str = __version__
     """The roadgaze version of the batch; a worker with another version refuses the drive."""
-
-
-@dataclass(frozen=True, slots=True)
-class DriveResult:
-    """One drive's outcome and summary: one row of `summary.parquet`."""
-
-    drive_id: str
-    path: str
-    driver_id: str | None
-    vehicle_id: str | None
-    start_time: str | None
-    """ISO 8601 with its zone."""
-    status: Status
-    resumed: bool = False
-    """The outputs come from an earlier run (the input and configuration had not changed)."""
-    error: str | None = None
-    warning: str | None = None
-    """A problem that did not stop the drive, e.g. a video that ended before its announced end."""
-    frames: int = 0
-    frames_with_face: int = 0
-    frames_gaze_known: int = 0
-    """Frames on which the monitor knew the gaze (on or off road)."""
-    frames_off_road: int = 0
-    duration_s: float = 0.0
-    """Video time from the first frame to the end of the last one."""
-    alert_counts: tuple[tuple[str, int], ...] = ()
-    """Alerts raised by kind; a long distraction escalated to critical counts once."""
-    critical_alerts: int = 0
-    longest_off_road_s: float = 0.0
-    """The longest continuous counted off-road episode (the monitor's `off_road_s`)."""
-    neutral_yaw_deg: float | None = None
-    """The monitor's road-ahead yaw at the end of the drive (learned unless configured)."""
-    processing_fps: float = 0.0
-    """Frames per second of the loop on this drive (start-up excluded)."""
-    startup_s: float = 0.0
-    """Opening the video and creating the landmarker."""
-    wall_s: float = 0.0
-    """The whole task, start-up and writing included."""
-
-    @classmethod
-    def of(cls, drive: Drive, status: Status, **values: Any) -> DriveResult:
-        start = drive.start_time.isoformat() if drive.start_time is not None else None
-        return cls(
-            drive_id=drive.drive_id,
-            path=str(drive.path),
-            driver_id=drive.driver_id,
-            vehicle_id=drive.vehicle_id,
-            start_time=start,
-            status=status,
-            **values,
-        )
-
-    @property
-    def face_found_rate(self) -> float | None:
-        return self.frames_with_face / self.frames if self.frames else None
-
-    @property
-    def off_road_ratio(self) -> float | None:
-        """Off-road frames over frames whose gaze is known."""
-        return self.frames_off_road / self.frames_gaze_known if self.frames_gaze_known else None
-
-    def to_json(self) -> dict[str, Any]:
-        return asdict(self)
-
-    @classmethod
-    def from_json(cls, values: dict[str, Any]) -> DriveResult:
-        counts = tuple((str(k), int(n)) for k, n in values.get("alert_counts", ()))
-        return cls(**{**values, "alert_counts": counts})
 
 
 def output_paths(out_dir: Path, drive_id: str) -> tuple[Path, Path]:
@@ -272,83 +196,16 @@ def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> 
             return DriveResult.of(drive, "interrupted", error="stopped before the end")
         if summary.frames == 0:
             return DriveResult.of(drive, "failed", error=f"video {drive.path} has no frame")
+        filled, offline_problem = recorder.offline_columns(config.smoothing)
+        warnings = [text for text in (summary.source_status.message, offline_problem) if text]
         result = recorder.result(
             drive,
             period_s=1.0 / source.info.fps if source.info.fps else 0.0,
-            warning=summary.source_status.message,
+            warning="; ".join(warnings) or None,
             processing_fps=summary.fps,
             startup_s=startup_s,
         )
         alerts.commit({"fingerprint": fingerprint})
         result = replace(result, wall_s=round(time.perf_counter() - started, 3))
-        frames.commit({"fingerprint": fingerprint, "summary": result.to_json()})
+        frames.commit({"fingerprint": fingerprint, "summary": result.to_json()}, filled)
         return result
-
-
-@dataclass(slots=True)
-class DriveRecorder:
-    """A pipeline sink: every record to the frames table, every alert to the alerts table, and
-    the counts of the drive's summary."""
-
-    frames: AtomicParquetWriter
-    alerts: AtomicParquetWriter
-    faces: int = 0
-    known_gaze: int = 0
-    off_road: int = 0
-    first_t_s: float | None = None
-    last_t_s: float = 0.0
-    longest_off_road_s: float = 0.0
-    neutral_yaw_deg: float | None = None
-    critical: int = 0
-    counts: dict[str, int] = field(default_factory=lambda: dict.fromkeys(ALERT_KINDS, 0))
-    _active: tuple[AlertKind, ...] = ()
-
-    def on_record(self, record: FrameRecord, frame: Frame) -> None:
-        self.frames.append(record_fields(record))
-        sample, verdict = record.sample, record.verdict
-        self.first_t_s = sample.t_s if self.first_t_s is None else self.first_t_s
-        self.last_t_s = sample.t_s
-        self.faces += sample.face
-        self.known_gaze += verdict.gaze is not Gaze.UNKNOWN
-        self.off_road += verdict.gaze is Gaze.OFF_ROAD
-        self.longest_off_road_s = max(self.longest_off_road_s, verdict.off_road_s)
-        self.neutral_yaw_deg = verdict.neutral_yaw_deg
-        for alert in record.alerts:
-            self.alerts.append({"frame": sample.frame, **alert_fields(alert)})
-            self.critical += alert.level is AlertLevel.CRITICAL
-            if alert.kind.value in self.counts and alert.kind not in self._active:
-                self.counts[alert.kind.value] += 1
-        self._active = verdict.active
-
-    def close(self) -> None:
-        return None
-
-    def result(
-        self,
-        drive: Drive,
-        period_s: float,
-        warning: str | None,
-        processing_fps: float,
-        startup_s: float,
-    ) -> DriveResult:
-        duration_s = self.last_t_s - (self.first_t_s or 0.0) + period_s
-        return DriveResult.of(
-            drive,
-            "ok",
-            warning=warning,
-            frames=self.frames.rows,
-            frames_with_face=self.faces,
-            frames_gaze_known=self.known_gaze,
-            frames_off_road=self.off_road,
-            duration_s=round(duration_s, 3),
-            alert_counts=tuple(self.counts.items()),
-            critical_alerts=self.critical,
-            longest_off_road_s=round(self.longest_off_road_s, 3),
-            neutral_yaw_deg=_finite_or_none(self.neutral_yaw_deg),
-            processing_fps=round(processing_fps, 2),
-            startup_s=round(startup_s, 3),
-        )
-
-
-def _finite_or_none(value: float | None) -> float | None:
-    return None if value is None or not math.isfinite(value) else round(value, 3)

@@ -1,10 +1,12 @@
 """Outputs: the flat per-frame record and its writers (JSONL, CSV), the plot and annotated video."""
 
 from roadgaze.outputs.annotate import AnnotatedVideoWriter, annotate, verdict_text
+from roadgaze.outputs.offline import fill_offline_columns
 from roadgaze.outputs.plots import YawPlot
 from roadgaze.outputs.progress import ProgressBar
 from roadgaze.outputs.records import (
     ALERT_SCHEMA,
+    OFFLINE_FIELDS,
     RECORD_FIELDS,
     RECORD_SCHEMA,
     CsvWriter,
@@ -20,6 +22,7 @@ from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
 __all__ = [
     "ALERT_SCHEMA",
     "FOURCC_BY_SUFFIX",
+    "OFFLINE_FIELDS",
     "RECORD_FIELDS",
     "RECORD_SCHEMA",
     "AnnotatedVideoWriter",
@@ -30,6 +33,7 @@ __all__ = [
     "YawPlot",
     "alert_fields",
     "annotate",
+    "fill_offline_columns",
     "open_for_writing",
     "open_video_writer",
     "record_fields",

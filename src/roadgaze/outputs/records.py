@@ -39,6 +39,8 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("yaw_deg", FieldType.FLOAT),
     ("yaw_rate_dps", FieldType.FLOAT),
     ("yaw_std_deg", FieldType.FLOAT),
+    ("pitch_raw_deg", FieldType.FLOAT),
+    ("pitch_deg", FieldType.FLOAT),
     ("x_left", FieldType.FLOAT),
     ("x_right", FieldType.FLOAT),
     ("x_center", FieldType.FLOAT),
@@ -46,17 +48,26 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("quality", FieldType.FLOAT),
     ("on_road", FieldType.BOOL),
     ("gaze", FieldType.STR),
+    ("zone", FieldType.STR),
+    ("eyes_on_road", FieldType.BOOL),
     ("neutral_yaw_deg", FieldType.FLOAT),
+    ("neutral_pitch_deg", FieldType.FLOAT),
     ("off_road_s", FieldType.FLOAT),
     ("window_off_road_s", FieldType.FLOAT),
+    ("distraction_s", FieldType.FLOAT),
     ("alerts", FieldType.STR_LIST),
+    ("yaw_offline_deg", FieldType.FLOAT),
+    ("pitch_offline_deg", FieldType.FLOAT),
 )
 """Every field of `record_fields`, in order, with its type: the one description the writers and
 the fleet's Parquet schema are derived from (x_* in pixels of the roll-removed frame). A field
 added to `record_fields` is added here too (a test checks it)."""
 
 RECORD_FIELDS = tuple(name for name, _ in RECORD_SCHEMA)
-"""The fields of `record_fields`, in order."""
+"""The fields of `record_fields`, in order. `yaw_offline_deg` / `pitch_offline_deg` are null
+while a replay streams; `fill_offline_columns` fills them at its end."""
+
+OFFLINE_FIELDS = ("yaw_offline_deg", "pitch_offline_deg")
 
 ALERT_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("kind", FieldType.STR),
@@ -92,17 +103,25 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "yaw_deg": rounded(sample.yaw_deg, 3),
         "yaw_rate_dps": rounded(sample.yaw_rate_dps, 3),
         "yaw_std_deg": rounded(sample.yaw_std_deg, 3),
+        "pitch_raw_deg": rounded(sample.pitch_raw_deg, 3),
+        "pitch_deg": rounded(sample.pitch_deg, 3),
         "x_left": None if features is None else rounded(features.x_left_px, 2),
         "x_right": None if features is None else rounded(features.x_right_px, 2),
         "x_center": None if features is None else rounded(features.x_center_px, 2),
-        "roll_deg": None if features is None else rounded(features.roll_deg, 2),
+        "roll_deg": rounded(sample.roll_deg, 2),
         "quality": None if features is None else rounded(features.quality, 3),
         "on_road": verdict.on_road,
         "gaze": verdict.gaze.value,
+        "zone": verdict.zone,
+        "eyes_on_road": verdict.on_road,
         "neutral_yaw_deg": round(verdict.neutral_yaw_deg, 3),
+        "neutral_pitch_deg": round(verdict.neutral_pitch_deg, 3),
         "off_road_s": round(verdict.off_road_s, 3),
         "window_off_road_s": round(verdict.window_off_road_s, 3),
+        "distraction_s": round(verdict.distraction_s, 3),
         "alerts": [alert.label for alert in record.alerts],
+        "yaw_offline_deg": None,
+        "pitch_offline_deg": None,
     }
 
 

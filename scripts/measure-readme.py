@@ -7,7 +7,7 @@
 Runs, with the `roadgaze` of the Python that runs this script:
 1. `roadgaze demo --out WORK/demo`, timed (the demo's own render/service/total split too);
 2. `roadgaze bench WORK/demo/drive.mp4 --json --repeat N --latency` on the demo's drive;
-3. `roadgaze synth --measure` (yaw recovery on synthetic stills with exact truth);
+3. `roadgaze synth --measure` (the service yaw's recovery on synthetic stills with exact truth);
 4. `roadgaze eval ../shared/data/pointing04-dev --workers 2 --report ...` when the evaluation
    data sits beside the checkout (skipped, and said so, otherwise);
 5. with `--soak S`, `roadgaze bench WORK/demo/drive.mp4 --loop-seconds S --memory --no-raw`.
@@ -189,8 +189,8 @@ def markdown(
         ranges = " / ".join(f"{mae:.1f}" for _, mae in synth_rows[:-1])
         labels = " / ".join(label for label, _ in synth_rows[:-1])
         lines.append(
-            f"| yaw recovery on synthetic stills | Center-CE MAE {ranges} deg for \\|yaw\\| in "
-            f"{labels} (all: {synth_rows[-1][1]:.1f}) | `roadgaze synth --measure` |"
+            f"| yaw recovery on synthetic stills | service yaw (full range) MAE {ranges} deg for "
+            f"\\|yaw\\| in {labels} (all: {synth_rows[-1][1]:.1f}) | `roadgaze synth --measure` |"
         )
     if eval_run is not None:
         lines += [

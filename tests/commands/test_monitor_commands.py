@@ -79,4 +79,4 @@ def test_listen_finds_the_vehicle_in_the_key() -> None:
 
 def test_bad_zenoh_option_is_a_one_line_error(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["listen", "--vehicle-id", "bad id!", "--timeout", "0.1"]) == 2
-    assert "vehicle_id" in capsys.readouterr().err
+    assert "vehicle id must be 1-64" in capsys.readouterr().err

@@ -15,6 +15,7 @@ from contextlib import contextmanager
 from typing import IO, Any
 
 import zenoh
+from zenoh.ext import HistoryConfig, RecoveryConfig, declare_advanced_subscriber
 
 
 def free_port() -> int:
@@ -171,6 +172,42 @@ def _serve_router(listen: str, config_file: str | None) -> None:
             time.sleep(3600)
     finally:
         session.close()
+
+
+class AdvancedListener:
+    """An advanced subscriber with history and recovery; records (arrival time, alert)."""
+
+    def __init__(self, session: zenoh.Session, key: str, history: int = 100) -> None:
+        self._lock = threading.Lock()
+        self.alerts: list[tuple[float, dict[str, Any]]] = []
+        self.misses: list[int] = []
+        self.subscriber = declare_advanced_subscriber(
+            session,
+            key,
+            self._on_sample,
+            history=HistoryConfig(detect_late_publishers=True, max_samples=history),
+            recovery=RecoveryConfig(heartbeat=True),  # type: ignore[call-arg]
+        )
+        self.miss_listener = self.subscriber.sample_miss_listener(
+            lambda miss: self.misses.append(miss.nb)
+        )
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        alert = json.loads(sample.payload.to_bytes())
+        with self._lock:
+            self.alerts.append((time.monotonic(), alert))
+
+    def seqs(self) -> list[int]:
+        with self._lock:
+            return [alert["seq"] for _, alert in self.alerts]
+
+    def kinds(self) -> list[str]:
+        with self._lock:
+            return [f"{alert['kind']}:{alert['level']}" for _, alert in self.alerts]
+
+    def close(self) -> None:
+        self.miss_listener.undeclare()
+        self.subscriber.undeclare()
 
 
 if __name__ == "__main__":

@@ -7,61 +7,29 @@ docs/zenoh.md example use) run in this process, each with its own session, on 12
 
 from __future__ import annotations
 
-import json
-import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
 import zenoh
-from zenoh.ext import HistoryConfig, RecoveryConfig, declare_advanced_subscriber
 
 from fakes import ListSource, ScriptedDetector, alert_message
 from roadgaze.config import Config, ZenohConfig
 from roadgaze.pipeline import Pipeline
 from roadgaze.transport import BusPublisher, Health, Keys, ZenohLink
-from zenoh_helpers import RouterProcess, client_config, endpoint, free_port, wait_for
+from zenoh_helpers import (
+    AdvancedListener,
+    RouterProcess,
+    client_config,
+    endpoint,
+    free_port,
+    wait_for,
+)
 
 FPS = 10.0
 GLANCE = [0.0] * 10 + [45.0] * 70 + [0.0] * 20
 """Road 1 s, a 7 s glance to 45 deg (long_distraction at 4 s, critical at 7 s), road 2 s."""
-
-
-class AdvancedListener:
-    """An advanced subscriber with history and recovery; records (arrival time, alert)."""
-
-    def __init__(self, session: zenoh.Session, key: str, history: int = 100) -> None:
-        self._lock = threading.Lock()
-        self.alerts: list[tuple[float, dict[str, Any]]] = []
-        self.misses: list[int] = []
-        self.subscriber = declare_advanced_subscriber(
-            session,
-            key,
-            self._on_sample,
-            history=HistoryConfig(detect_late_publishers=True, max_samples=history),
-            recovery=RecoveryConfig(heartbeat=True),  # type: ignore[call-arg]
-        )
-        self.miss_listener = self.subscriber.sample_miss_listener(
-            lambda miss: self.misses.append(miss.nb)
-        )
-
-    def _on_sample(self, sample: zenoh.Sample) -> None:
-        alert = json.loads(sample.payload.to_bytes())
-        with self._lock:
-            self.alerts.append((time.monotonic(), alert))
-
-    def seqs(self) -> list[int]:
-        with self._lock:
-            return [alert["seq"] for _, alert in self.alerts]
-
-    def kinds(self) -> list[str]:
-        with self._lock:
-            return [f"{alert['kind']}:{alert['level']}" for _, alert in self.alerts]
-
-    def close(self) -> None:
-        self.miss_listener.undeclare()
-        self.subscriber.undeclare()
 
 
 @contextmanager

@@ -13,6 +13,7 @@ from roadgaze.commands import (
     replay,
     run,
     schema,
+    security,
     synth,
 )
 
@@ -27,6 +28,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     synth,
     model,
     schema,
+    security,
     paper,
 )
 """Each module has `register(subparsers)`, which adds its parser and sets `handler(args, config)`.

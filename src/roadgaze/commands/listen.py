@@ -169,10 +169,10 @@ class _Listener:
         self.connected: set[str] = set()
         self.ever_connected = False
         self.warn = ThrottledWarning(log, "roadgaze listen: message rejected", period_s=5.0)
+        self._sample_kind_put = zenoh.SampleKind.PUT
         self.entities: list[Any] = [
             session.info.declare_transport_events_listener(self._on_transport, history=True)
         ]
-        self._sample_kind_put = zenoh.SampleKind.PUT
 
     def _on_transport(self, event: Any) -> None:
         zid = str(event.transport.zid)

@@ -1,0 +1,267 @@
+"""Frame-loop slowdown of the daemon under bus floods, for one or more source trees.
+
+    python scripts/bus_flood_bench.py --tree before=/tmp/base/src --tree after=src \
+        [--rounds 3] [--seconds 8] [--work mediapipe|numpy]
+
+For every round, tree and flood (none; 10 MB puts on the speed key as fast as a client can;
+2,000 state queries a second; the same two on another vehicle's keys, which the daemon does not
+declare: what the router and flooder alone cost on a shared machine) it starts, each in its own
+process: a Python router on a free loopback port, the daemon's bus outputs and frame loop from
+that tree (`bus_outputs` + `Pipeline`, real MediaPipe on a synthetic clip by default), and the
+flooder. The daemon records the wall time
+between consecutive frames; the figure is the median over the measured window, and the slowdown
+is median(flood) / median(none of the same round and tree) - 1. A client also asks for the state
+once a second during the window (a legitimate health check): answered/asked is reported.
+Runs are interleaved (tree, flood) within each round because other load on the machine moves
+absolute numbers; compare within a round. Prints one JSON line per run and a summary table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import os
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve()
+REPO = HERE.parents[1]
+VEHICLE = "bench"
+FLOODS = ("none", "speed-10MB", "speed-10MB-elsewhere", "queries-2000/s", "queries-elsewhere")
+
+ROUTER = """
+import json, sys, time, zenoh
+conf = {"mode": "router", "listen": {"endpoints": [sys.argv[1]]},
+        "scouting": {"multicast": {"enabled": False}}}
+session = zenoh.open(zenoh.Config.from_json5(json.dumps(conf)))
+print("ready", flush=True)
+while True:
+    time.sleep(3600)
+"""
+
+FLOODER = """
+import json, signal, sys, time, zenoh
+endpoint, mode = sys.argv[1], sys.argv[2]
+vehicle = "other" if mode.endswith("elsewhere") else "bench"
+conf = {"mode": "client", "connect": {"endpoints": [endpoint]},
+        "scouting": {"multicast": {"enabled": False}}}
+session = zenoh.open(zenoh.Config.from_json5(json.dumps(conf)))
+running = True
+def stop(*_):
+    global running
+    running = False
+signal.signal(signal.SIGTERM, stop)
+payload = b'{"kmh": 50, "pad": "' + b"a" * (10_000_000 - 30) + b'"}'
+sent, period, next_t = 0, 1 / 2000, time.perf_counter()
+print("started", flush=True)
+while running:
+    if mode.startswith("speed"):
+        session.put(f"vehicle/{vehicle}/speed", payload)
+    else:
+        session.get(f"vehicle/{vehicle}/dms/state", lambda reply: None, timeout=1.0,
+                    consolidation=zenoh.ConsolidationMode.NONE)
+        next_t += period
+        delay = next_t - time.perf_counter()
+        if delay > 0:
+            time.sleep(delay)
+        elif delay < -1.0:
+            next_t = time.perf_counter()
+    sent += 1
+print("sent", sent, flush=True)
+"""
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def run_daemon(args: argparse.Namespace) -> int:
+    """Child: the daemon's bus outputs and frame loop from the tree on sys.path."""
+    import numpy as np
+
+    from roadgaze.capture import LoopingSource, VideoFileSource
+    from roadgaze.config import Config
+    from roadgaze.daemon import bus_outputs
+    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.types import Detection
+
+    config = Config.model_validate(
+        {"zenoh": {"vehicle_id": VEHICLE, "connect": [f"tcp/127.0.0.1:{args.port}"]}}
+    )
+
+    class NumpyWork:
+        """About 10 ms of single-threaded numpy per frame (the GIL is released in BLAS)."""
+
+        def __init__(self) -> None:
+            self.matrix = np.random.default_rng(0).standard_normal((260, 260))
+
+        def detect(self, image: Any, t_s: float | None = None) -> Detection:
+            product = self.matrix
+            for _ in range(6):
+                product = np.tanh(product @ self.matrix / 260.0)
+            return Detection(faces=(), driver_index=None)
+
+        def close(self) -> None:
+            return None
+
+    class FrameTimes:
+        def __init__(self) -> None:
+            self.stamps: list[float] = []
+
+        def on_record(self, record: Any, frame: Any) -> None:
+            self.stamps.append(time.monotonic())
+
+        def close(self) -> None:
+            return None
+
+    detector = NumpyWork() if args.work == "numpy" else create_detector(config)
+    times = FrameTimes()
+    total_s = args.warmup + args.seconds + 1.0
+    source = LoopingSource(lambda: VideoFileSource(Path(args.clip)), duration_s=total_s)
+    with bus_outputs(config, "bench", publish=True) as bus:
+        pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
+        print("ready", flush=True)
+        started = time.monotonic()
+        pipeline.run(source, [*bus.sinks, times])
+        state = bus.health.state_message().transport.model_dump()
+    detector.close()
+    window = [
+        t
+        for t in times.stamps
+        if started + args.warmup <= t <= started + args.warmup + args.seconds
+    ]
+    intervals_ms = [(b - a) * 1e3 for a, b in itertools.pairwise(window)]
+    print(json.dumps({
+        "frames": len(intervals_ms),
+        "median_ms": statistics.median(intervals_ms) if intervals_ms else None,
+        "p90_ms": statistics.quantiles(intervals_ms, n=10)[-1] if len(intervals_ms) > 10 else None,
+        "transport": {k: v for k, v in state.items() if isinstance(v, int)},
+    }), flush=True)  # fmt: skip
+    return 0
+
+
+def spawn(code_or_args: list[str], env: dict[str, str] | None = None) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [sys.executable, *code_or_args],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        env=env,
+    )
+
+
+def wait_line(process: subprocess.Popen[str], prefix: str, timeout_s: float = 60.0) -> str:
+    assert process.stdout is not None
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        line = process.stdout.readline()
+        if not line and process.poll() is not None:
+            break
+        if line.startswith(prefix):
+            return line
+    raise RuntimeError(f"no '{prefix}' line from {process.args}")
+
+
+def one_run(tree: str, flood: str, args: argparse.Namespace, clip: Path) -> dict[str, Any]:
+    import zenoh
+
+    port = free_port()
+    endpoint = f"tcp/127.0.0.1:{port}"
+    env = dict(os.environ, PYTHONPATH=tree, GLOG_minloglevel="2")
+    router = spawn(["-c", ROUTER, endpoint])
+    processes = [router]
+    try:
+        wait_line(router, "ready")
+        daemon = spawn(
+            [str(HERE), "--daemon", "--port", str(port), "--clip", str(clip), "--work", args.work,
+             "--seconds", str(args.seconds), "--warmup", str(args.warmup)],
+            env=env,
+        )  # fmt: skip
+        processes.append(daemon)
+        wait_line(daemon, "ready", timeout_s=120.0)
+        if flood != "none":
+            flooder = spawn(["-c", FLOODER, endpoint, flood])
+            processes.append(flooder)
+            wait_line(flooder, "started")
+        conf = {"mode": "client", "connect": {"endpoints": [endpoint]},
+                "scouting": {"multicast": {"enabled": False}}}  # fmt: skip
+        asked = answered = 0
+        with zenoh.open(zenoh.Config.from_json5(json.dumps(conf))) as health:
+            time.sleep(args.warmup)
+            end = time.monotonic() + args.seconds
+            while time.monotonic() < end:
+                asked += 1
+                replies = health.get(f"vehicle/{VEHICLE}/dms/state", timeout=1.0)
+                answered += any(reply.ok is not None for reply in replies)
+                time.sleep(max(0.0, 1.0 - (time.monotonic() % 1.0)))
+        for process in processes[2:]:
+            process.terminate()
+        result = json.loads(wait_line(daemon, "{", timeout_s=120.0))
+    finally:
+        for process in reversed(processes):
+            if process.poll() is None:
+                process.kill()
+            process.wait(timeout=30)
+    return result | {"health_answered": f"{answered}/{asked}"}
+
+
+def make_clip(folder: Path) -> Path:
+    clip = folder / "drive.mkv"
+    subprocess.run(
+        [sys.executable, "-m", "roadgaze", "synth", "--timeline", "0:2,40:2,0:2", "--out",
+         str(clip), "--size", "640x480"],
+        check=True, capture_output=True, env=dict(os.environ, PYTHONPATH=str(REPO / "src")),
+    )  # fmt: skip
+    return clip
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--tree", action="append", default=[], metavar="NAME=SRC")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--seconds", type=float, default=8.0, help="measured window per run")
+    parser.add_argument("--warmup", type=float, default=4.0)
+    parser.add_argument("--work", choices=["mediapipe", "numpy"], default="mediapipe")
+    parser.add_argument("--daemon", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--port", type=int, help=argparse.SUPPRESS)
+    parser.add_argument("--clip", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.daemon:
+        return run_daemon(args)
+    trees = dict(item.split("=", 1) for item in args.tree) or {"this": str(REPO / "src")}
+    table: dict[tuple[str, str], list[float]] = {}
+    with tempfile.TemporaryDirectory() as folder:
+        clip = make_clip(Path(folder))
+        for round_index in range(args.rounds):
+            for name, tree in trees.items():
+                baseline = None
+                for flood in FLOODS:
+                    result = one_run(str(Path(tree).resolve()), flood, args, clip)
+                    median = result["median_ms"]
+                    if flood == "none":
+                        baseline = median
+                    slowdown = None if not (baseline and median) else median / baseline - 1
+                    result |= {"round": round_index, "tree": name, "flood": flood,
+                               "slowdown": slowdown}  # fmt: skip
+                    print(json.dumps(result), flush=True)
+                    if slowdown is not None and flood != "none":
+                        table.setdefault((name, flood), []).append(slowdown)
+    print("\ntree     flood              slowdown per round (median frame interval vs no flood)")
+    for (name, flood), values in table.items():
+        shown = ", ".join(f"{100 * value:+.0f} %" for value in values)
+        print(f"{name:<8} {flood:<18} {shown}  (median {100 * statistics.median(values):+.0f} %)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

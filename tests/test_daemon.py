@@ -539,3 +539,58 @@ def test_run_refuses_a_vehicle_id_that_is_not_one_vehicle(
     assert main(["run", "--source", "/dev/video97", "--vehicle-id", vehicle_id]) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "--vehicle-id" in lines[0] and len(lines[0]) < 400, lines[:3]
+
+
+@pytest.mark.parametrize("with_router", [False, True], ids=["alone", "router-on-the-port"])
+def test_run_and_listen_without_endpoint_flags_find_each_other(with_router: bool) -> None:
+    """The documented default: both meet at the rendezvous endpoint (7447 in real use; a free
+    port here, set through the environment like a user's setting). `run` logs where it listens or
+    connects and says "connected" only once a consumer (or the router) really is."""
+    import os
+    from contextlib import nullcontext
+
+    port = free_port()
+    env = ENV | {"ROADGAZE__ZENOH__RENDEZVOUS": endpoint(port)}
+    with router(port) if with_router else nullcontext():
+        daemon = subprocess.Popen(
+            [sys.executable, str(FAKE_DAEMON), "--vehicle-id", "meet"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+        )  # fmt: skip
+        listener: subprocess.Popen[str] | None = None
+        try:
+            assert daemon.stderr is not None
+            daemon_log = LineReader(daemon, daemon.stderr)
+            lines: list[str] = []
+            while not any("roadgaze run: source" in line for line in lines):
+                line = daemon_log.next(60.0)
+                assert line is not None, "daemon did not start"
+                lines.append(line)
+            time.sleep(1.0)
+            while (line := daemon_log.next(0.1)) is not None:
+                lines.append(line)
+            connected_alone = any("zenoh connected" in line for line in lines)
+            listener = subprocess.Popen(
+                [sys.executable, "-m", "roadgaze", "listen", "--no-yaw", "--count", "2",
+                 "--timeout", "30"],
+                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+            )  # fmt: skip
+            stdout, listen_log = listener.communicate(timeout=60)
+            daemon.send_signal(signal.SIGTERM)
+            assert daemon.wait(timeout=30) == 0
+            lines += (daemon.stderr.read() or "").splitlines()
+        finally:
+            stop_process(daemon)
+            if listener is not None:
+                stop_process(listener)
+    assert os.linesep.join(stdout.splitlines()[:2]).startswith("alive  meet joined")
+    assert "ALERT  meet #0 long_distraction warning" in stdout
+    assert listener.returncode == 0, listen_log
+    assert f"connecting to {endpoint(port)}" in listen_log
+    daemon_text = "\n".join(lines)
+    if with_router:
+        assert f"connecting to {endpoint(port)}" in daemon_text
+        assert connected_alone and "zenoh connected: router" in daemon_text
+    else:
+        assert f"listening on {endpoint(port)}" in daemon_text
+        assert not connected_alone  # nobody there yet: no "connected"
+        assert "zenoh connected: client" in daemon_text

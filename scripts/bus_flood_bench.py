@@ -1,19 +1,20 @@
 """Frame-loop slowdown of the daemon under bus floods, for one or more source trees.
 
     python scripts/bus_flood_bench.py --tree before=/tmp/base/src --tree after=src \
-        [--rounds 3] [--seconds 8] [--work mediapipe|numpy]
+        [--rounds 3] [--cycles 5] [--work mediapipe|numpy]
 
-For every round, tree and flood (none; 10 MB puts on the speed key as fast as a client can;
-2,000 state queries a second; the same two on another vehicle's keys, which the daemon does not
-declare: what the router and flooder alone cost on a shared machine) it starts, each in its own
-process: a Python router on a free loopback port, the daemon's bus outputs and frame loop from
-that tree (`bus_outputs` + `Pipeline`, real MediaPipe on a synthetic clip by default), and the
-flooder. The daemon records the wall time
-between consecutive frames; the figure is the median over the measured window, and the slowdown
-is median(flood) / median(none of the same round and tree) - 1. A client also asks for the state
-once a second during the window (a legitimate health check): answered/asked is reported.
-Runs are interleaved (tree, flood) within each round because other load on the machine moves
-absolute numbers; compare within a round. Prints one JSON line per run and a summary table.
+For every round, tree and flood (10 MB puts on the speed key as fast as a client can; 2,000
+state queries a second; the same two on another vehicle's keys, which the daemon does not
+declare: what the router and the flooder alone cost on a shared machine) it starts, each in its
+own process: a Python router on a free loopback port, the daemon's bus outputs and frame loop
+from that tree (`bus_outputs` + `Pipeline`, real MediaPipe on a synthetic clip by default), and
+the flooder. The flooder is switched on and off (SIGCONT/SIGSTOP) every `--period` seconds for
+`--cycles` cycles, so each flooded window has an unflooded neighbour in the same process: the
+other load on a shared machine drifts more slowly than that. The daemon records the wall time
+between consecutive frames; the slowdown of a run is median(interval, flood on) /
+median(interval, flood off) - 1 (0.4 s after each switch left out). A client also asks for the
+state twice a second (a legitimate health check): answered/asked per window state is reported.
+Prints one JSON line per run and a summary table.
 """
 
 from __future__ import annotations
@@ -22,11 +23,13 @@ import argparse
 import itertools
 import json
 import os
+import signal
 import socket
 import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -34,7 +37,9 @@ from typing import Any
 HERE = Path(__file__).resolve()
 REPO = HERE.parents[1]
 VEHICLE = "bench"
-FLOODS = ("none", "speed-10MB", "speed-10MB-elsewhere", "queries-2000/s", "queries-elsewhere")
+FLOODS = ("speed-10MB", "speed-10MB-elsewhere", "queries-2000/s", "queries-elsewhere")
+SETTLE_S = 0.4
+"""Left out after each switch of the flood: queued data drains, the flooder restarts."""
 
 ROUTER = """
 import json, sys, time, zenoh
@@ -125,27 +130,17 @@ def run_daemon(args: argparse.Namespace) -> int:
 
     detector = NumpyWork() if args.work == "numpy" else create_detector(config)
     times = FrameTimes()
-    total_s = args.warmup + args.seconds + 1.0
-    source = LoopingSource(lambda: VideoFileSource(Path(args.clip)), duration_s=total_s)
+    stop = threading.Event()
+    threading.Thread(target=lambda: (sys.stdin.readline(), stop.set()), daemon=True).start()
+    source = LoopingSource(lambda: VideoFileSource(Path(args.clip)), duration_s=600.0)
     with bus_outputs(config, "bench", publish=True) as bus:
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         print("ready", flush=True)
-        started = time.monotonic()
-        pipeline.run(source, [*bus.sinks, times])
+        pipeline.run(source, [*bus.sinks, times], stop=stop)
         state = bus.health.state_message().transport.model_dump()
     detector.close()
-    window = [
-        t
-        for t in times.stamps
-        if started + args.warmup <= t <= started + args.warmup + args.seconds
-    ]
-    intervals_ms = [(b - a) * 1e3 for a, b in itertools.pairwise(window)]
-    print(json.dumps({
-        "frames": len(intervals_ms),
-        "median_ms": statistics.median(intervals_ms) if intervals_ms else None,
-        "p90_ms": statistics.quantiles(intervals_ms, n=10)[-1] if len(intervals_ms) > 10 else None,
-        "transport": {k: v for k, v in state.items() if isinstance(v, int)},
-    }), flush=True)  # fmt: skip
+    counters = {k: v for k, v in state.items() if isinstance(v, int) and not isinstance(v, bool)}
+    print(json.dumps({"stamps": times.stamps, "transport": counters}), flush=True)
     return 0
 
 
@@ -172,47 +167,79 @@ def wait_line(process: subprocess.Popen[str], prefix: str, timeout_s: float = 60
     raise RuntimeError(f"no '{prefix}' line from {process.args}")
 
 
-def one_run(tree: str, flood: str, args: argparse.Namespace, clip: Path) -> dict[str, Any]:
+def _health_checks(endpoint: str, until: threading.Event, asked: list[tuple[float, bool]]) -> None:
     import zenoh
 
+    conf = {"mode": "client", "connect": {"endpoints": [endpoint]},
+            "scouting": {"multicast": {"enabled": False}}}  # fmt: skip
+    with zenoh.open(zenoh.Config.from_json5(json.dumps(conf))) as session:
+        while not until.wait(0.5):
+            at = time.monotonic()
+            replies = session.get(f"vehicle/{VEHICLE}/dms/state", timeout=0.5)
+            asked.append((at, any(reply.ok is not None for reply in replies)))
+
+
+def one_run(tree: str, flood: str, args: argparse.Namespace, clip: Path) -> dict[str, Any]:
     port = free_port()
     endpoint = f"tcp/127.0.0.1:{port}"
     env = dict(os.environ, PYTHONPATH=tree, GLOG_minloglevel="2")
     router = spawn(["-c", ROUTER, endpoint])
     processes = [router]
+    windows: list[tuple[float, float, bool]] = []
+    asked: list[tuple[float, bool]] = []
     try:
         wait_line(router, "ready")
         daemon = spawn(
-            [str(HERE), "--daemon", "--port", str(port), "--clip", str(clip), "--work", args.work,
-             "--seconds", str(args.seconds), "--warmup", str(args.warmup)],
+            [str(HERE), "--daemon", "--port", str(port), "--clip", str(clip), "--work", args.work],
             env=env,
-        )  # fmt: skip
+        )
         processes.append(daemon)
         wait_line(daemon, "ready", timeout_s=120.0)
-        if flood != "none":
-            flooder = spawn(["-c", FLOODER, endpoint, flood])
-            processes.append(flooder)
-            wait_line(flooder, "started")
-        conf = {"mode": "client", "connect": {"endpoints": [endpoint]},
-                "scouting": {"multicast": {"enabled": False}}}  # fmt: skip
-        asked = answered = 0
-        with zenoh.open(zenoh.Config.from_json5(json.dumps(conf))) as health:
-            time.sleep(args.warmup)
-            end = time.monotonic() + args.seconds
-            while time.monotonic() < end:
-                asked += 1
-                replies = health.get(f"vehicle/{VEHICLE}/dms/state", timeout=1.0)
-                answered += any(reply.ok is not None for reply in replies)
-                time.sleep(max(0.0, 1.0 - (time.monotonic() % 1.0)))
-        for process in processes[2:]:
-            process.terminate()
+        flooder = spawn(["-c", FLOODER, endpoint, flood])
+        processes.append(flooder)
+        wait_line(flooder, "started")
+        flooder.send_signal(signal.SIGSTOP)
+        done = threading.Event()
+        checker = threading.Thread(target=_health_checks, args=(endpoint, done, asked))
+        checker.start()
+        time.sleep(args.warmup)
+        for _ in range(args.cycles):
+            for on in (True, False):
+                flooder.send_signal(signal.SIGCONT if on else signal.SIGSTOP)
+                start = time.monotonic()
+                time.sleep(args.period)
+                windows.append((start, time.monotonic(), on))
+        done.set()
+        checker.join(timeout=10)
+        assert daemon.stdin is not None
+        daemon.stdin.write("stop\n")
+        daemon.stdin.flush()
         result = json.loads(wait_line(daemon, "{", timeout_s=120.0))
     finally:
         for process in reversed(processes):
             if process.poll() is None:
+                process.send_signal(signal.SIGCONT)
                 process.kill()
             process.wait(timeout=30)
-    return result | {"health_answered": f"{answered}/{asked}"}
+    stamps = result.pop("stamps")
+    intervals: dict[bool, list[float]] = {True: [], False: []}
+    health: dict[bool, list[bool]] = {True: [], False: []}
+    for begin, end, on in windows:
+        intervals[on] += [(b - a) * 1e3 for a, b in itertools.pairwise(stamps)
+                          if begin + SETTLE_S <= a and b <= end]  # fmt: skip
+        health[on] += [ok for at, ok in asked if begin + SETTLE_S <= at <= end]
+    median_on = statistics.median(intervals[True]) if intervals[True] else None
+    median_off = statistics.median(intervals[False]) if intervals[False] else None
+    return result | {
+        "median_ms_flood_off": median_off,
+        "median_ms_flood_on": median_on,
+        "frames": {"off": len(intervals[False]), "on": len(intervals[True])},
+        "slowdown": None if not (median_on and median_off) else median_on / median_off - 1,
+        "health_answered": {
+            state: f"{sum(health[on])}/{len(health[on])}"
+            for state, on in (("off", False), ("on", True))
+        },
+    }
 
 
 def make_clip(folder: Path) -> Path:
@@ -229,7 +256,8 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--tree", action="append", default=[], metavar="NAME=SRC")
     parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--seconds", type=float, default=8.0, help="measured window per run")
+    parser.add_argument("--cycles", type=int, default=5, help="flood on/off cycles per run")
+    parser.add_argument("--period", type=float, default=2.0, help="seconds on, then off")
     parser.add_argument("--warmup", type=float, default=4.0)
     parser.add_argument("--work", choices=["mediapipe", "numpy"], default="mediapipe")
     parser.add_argument("--daemon", action="store_true", help=argparse.SUPPRESS)
@@ -243,23 +271,17 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as folder:
         clip = make_clip(Path(folder))
         for round_index in range(args.rounds):
-            for name, tree in trees.items():
-                baseline = None
-                for flood in FLOODS:
+            for flood in FLOODS:
+                for name, tree in trees.items():
                     result = one_run(str(Path(tree).resolve()), flood, args, clip)
-                    median = result["median_ms"]
-                    if flood == "none":
-                        baseline = median
-                    slowdown = None if not (baseline and median) else median / baseline - 1
-                    result |= {"round": round_index, "tree": name, "flood": flood,
-                               "slowdown": slowdown}  # fmt: skip
+                    result |= {"round": round_index, "tree": name, "flood": flood}
                     print(json.dumps(result), flush=True)
-                    if slowdown is not None and flood != "none":
-                        table.setdefault((name, flood), []).append(slowdown)
-    print("\ntree     flood              slowdown per round (median frame interval vs no flood)")
-    for (name, flood), values in table.items():
+                    if result["slowdown"] is not None:
+                        table.setdefault((name, flood), []).append(result["slowdown"])
+    print("\ntree     flood                 slowdown per run (median frame interval, on vs off)")
+    for (name, flood), values in sorted(table.items()):
         shown = ", ".join(f"{100 * value:+.0f} %" for value in values)
-        print(f"{name:<8} {flood:<18} {shown}  (median {100 * statistics.median(values):+.0f} %)")
+        print(f"{name:<8} {flood:<21} {shown}  (median {100 * statistics.median(values):+.0f} %)")
     return 0
 
 

@@ -130,8 +130,10 @@ def run(args: argparse.Namespace, config: Config) -> int:
                 return 0
             if timeout_s is None:
                 raise
-            _say(f"connected to nothing ({endpoints}) in {timeout_s:g} s: is `roadgaze run` "
-                 "or a router up?")  # fmt: skip
+            _say(
+                f"connected to nothing ({endpoints}) in {timeout_s:g} s: is `roadgaze run` "
+                "or a router up?"
+            )
             return 1
         with session:
             listener = _Listener(args, zconf.prefix, keys, session, zconf.alert_cache_size)
@@ -241,11 +243,15 @@ class _Listener:
             _say(f"{self.dropped} messages dropped (printing too slow)")
         if printed == 0 and timeout_s is not None and not stop.is_set():
             if not self.ever_connected:
-                _say(f"connected to nothing ({endpoints}) in {timeout_s:g} s: is `roadgaze run` "
-                     "or a router up?")  # fmt: skip
+                _say(
+                    f"connected to nothing ({endpoints}) in {timeout_s:g} s: is `roadgaze run` "
+                    "or a router up?"
+                )
             else:
-                _say(f"received nothing on {self.keys.prefix}/* in {timeout_s:g} s: is a daemon "
-                     "publishing for this vehicle?")  # fmt: skip
+                _say(
+                    f"received nothing on {self.keys.prefix}/* in {timeout_s:g} s: is a daemon "
+                    "publishing for this vehicle?"
+                )
             return 1
         return 0
 
@@ -254,8 +260,10 @@ class _Listener:
 
         vehicle = vehicle_of(key, self.prefix_template)
         if kind == "missed":
-            _say(f"MISSED {data!r} alerts of {vehicle}: lost before this listener could recover "
-                 "them (older than the daemon's zenoh.alert_cache_size)")  # fmt: skip
+            _say(
+                f"MISSED {data!r} alerts of {vehicle}: lost before this listener could recover "
+                "them (older than the daemon's zenoh.alert_cache_size)"
+            )
             return 0
         if isinstance(data, int):
             self.warn(f"{kind} on {printable(key, 80)}: {data} bytes, limit {self.max_bytes}")
@@ -270,8 +278,10 @@ class _Listener:
                 return 0
             payload = checked.payload
             if checked.missing_before:
-                _say(f"GAP: {checked.missing_before} alerts of {vehicle} missing before #"
-                     f"{payload['seq']}")  # fmt: skip
+                _say(
+                    f"GAP: {checked.missing_before} alerts of {vehicle} missing before #"
+                    f"{payload['seq']}"
+                )
         self._show(kind, key, vehicle, payload)
         return 1
 
@@ -315,8 +325,10 @@ class _Listener:
             return 1
         twice = {vehicle: n for vehicle, statuses in answers.items() if (n := len(statuses)) > 1}
         if twice:
-            _say(f"suspicious: several answers for one vehicle {twice}: another process answers "
-                 "on its state key (see docs/security.md)")  # fmt: skip
+            _say(
+                f"suspicious: several answers for one vehicle {twice}: another process answers "
+                "on its state key (see docs/security.md)"
+            )
             return 3
         statuses = [status for found in answers.values() for status in found]
         return 0 if all(status == "running" for status in statuses) else 3

@@ -12,9 +12,11 @@ the flooder. The flooder is switched on and off (SIGCONT/SIGSTOP) every `--perio
 `--cycles` cycles, so each flooded window has an unflooded neighbour in the same process: the
 other load on a shared machine drifts more slowly than that. The daemon records the wall time
 between consecutive frames; the slowdown of a run is median(interval, flood on) /
-median(interval, flood off) - 1 (0.4 s after each switch left out). A client also asks for the
-state twice a second (a legitimate health check): answered/asked per window state is reported.
-Prints one JSON line per run and a summary table.
+median(interval, flood off) - 1 (0.4 s after each switch left out); the daemon process's CPU
+time per wall second (all its threads, Zenoh's included) is reported beside it, the figure the
+shared machine disturbs least. A client also asks for the state twice a second (a legitimate
+health check): answered/asked per window state is reported. Prints one JSON line per run and a
+summary table.
 """
 
 from __future__ import annotations
@@ -37,7 +39,15 @@ from typing import Any
 HERE = Path(__file__).resolve()
 REPO = HERE.parents[1]
 VEHICLE = "bench"
-FLOODS = ("speed-10MB", "speed-10MB-elsewhere", "queries-2000/s", "queries-elsewhere")
+FLOODS = (
+    "speed-10MB",
+    "speed-10MB-elsewhere",
+    "speed-10MB+router-limits",
+    "queries-2000/s",
+    "queries-elsewhere",
+    "queries-2000/s+router-limits",
+)
+"""'+router-limits': the router has the size and rate limits `roadgaze security init` writes."""
 SETTLE_S = 0.4
 """Left out after each switch of the flood: queued data drains, the flooder restarts."""
 
@@ -45,6 +55,7 @@ ROUTER = """
 import json, sys, time, zenoh
 conf = {"mode": "router", "listen": {"endpoints": [sys.argv[1]]},
         "scouting": {"multicast": {"enabled": False}}}
+conf.update(json.loads(sys.argv[2]))
 session = zenoh.open(zenoh.Config.from_json5(json.dumps(conf)))
 print("ready", flush=True)
 while True:
@@ -120,10 +131,10 @@ def run_daemon(args: argparse.Namespace) -> int:
 
     class FrameTimes:
         def __init__(self) -> None:
-            self.stamps: list[float] = []
+            self.stamps: list[tuple[float, float]] = []
 
         def on_record(self, record: Any, frame: Any) -> None:
-            self.stamps.append(time.monotonic())
+            self.stamps.append((time.monotonic(), time.process_time()))
 
         def close(self) -> None:
             return None
@@ -183,7 +194,16 @@ def one_run(tree: str, flood: str, args: argparse.Namespace, clip: Path) -> dict
     port = free_port()
     endpoint = f"tcp/127.0.0.1:{port}"
     env = dict(os.environ, PYTHONPATH=tree, GLOG_minloglevel="2")
-    router = spawn(["-c", ROUTER, endpoint])
+    limits: dict[str, Any] = {}
+    if flood.endswith("+router-limits"):
+        from roadgaze.config import ZenohConfig
+        from roadgaze.security import downsampling, low_pass_filter
+        from roadgaze.transport import Keys
+
+        keys = Keys.from_config(ZenohConfig(), VEHICLE)
+        limits = {"low_pass_filter": low_pass_filter(keys), "downsampling": downsampling(keys)}
+        flood = flood.removesuffix("+router-limits")
+    router = spawn(["-c", ROUTER, endpoint, json.dumps(limits)])
     processes = [router]
     windows: list[tuple[float, float, bool]] = []
     asked: list[tuple[float, bool]] = []
@@ -223,10 +243,15 @@ def one_run(tree: str, flood: str, args: argparse.Namespace, clip: Path) -> dict
             process.wait(timeout=30)
     stamps = result.pop("stamps")
     intervals: dict[bool, list[float]] = {True: [], False: []}
+    cpu_s: dict[bool, float] = {True: 0.0, False: 0.0}
+    wall_s: dict[bool, float] = {True: 0.0, False: 0.0}
     health: dict[bool, list[bool]] = {True: [], False: []}
     for begin, end, on in windows:
-        intervals[on] += [(b - a) * 1e3 for a, b in itertools.pairwise(stamps)
-                          if begin + SETTLE_S <= a and b <= end]  # fmt: skip
+        for (wall_a, cpu_a), (wall_b, cpu_b) in itertools.pairwise(stamps):
+            if begin + SETTLE_S <= wall_a and wall_b <= end:
+                intervals[on].append((wall_b - wall_a) * 1e3)
+                cpu_s[on] += cpu_b - cpu_a
+                wall_s[on] += wall_b - wall_a
         health[on] += [ok for at, ok in asked if begin + SETTLE_S <= at <= end]
     median_on = statistics.median(intervals[True]) if intervals[True] else None
     median_off = statistics.median(intervals[False]) if intervals[False] else None
@@ -234,6 +259,10 @@ def one_run(tree: str, flood: str, args: argparse.Namespace, clip: Path) -> dict
         "median_ms_flood_off": median_off,
         "median_ms_flood_on": median_on,
         "frames": {"off": len(intervals[False]), "on": len(intervals[True])},
+        "daemon_cpu_cores": {
+            "off": round(cpu_s[False] / wall_s[False], 3) if wall_s[False] else None,
+            "on": round(cpu_s[True] / wall_s[True], 3) if wall_s[True] else None,
+        },
         "slowdown": None if not (median_on and median_off) else median_on / median_off - 1,
         "health_answered": {
             state: f"{sum(health[on])}/{len(health[on])}"
@@ -260,6 +289,7 @@ def main() -> int:
     parser.add_argument("--period", type=float, default=2.0, help="seconds on, then off")
     parser.add_argument("--warmup", type=float, default=4.0)
     parser.add_argument("--work", choices=["mediapipe", "numpy"], default="mediapipe")
+    parser.add_argument("--flood", action="append", choices=FLOODS, help="default: all")
     parser.add_argument("--daemon", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--port", type=int, help=argparse.SUPPRESS)
     parser.add_argument("--clip", help=argparse.SUPPRESS)
@@ -268,20 +298,34 @@ def main() -> int:
         return run_daemon(args)
     trees = dict(item.split("=", 1) for item in args.tree) or {"this": str(REPO / "src")}
     table: dict[tuple[str, str], list[float]] = {}
+    cpu: dict[tuple[str, str], list[tuple[float, float, str]]] = {}
     with tempfile.TemporaryDirectory() as folder:
         clip = make_clip(Path(folder))
         for round_index in range(args.rounds):
-            for flood in FLOODS:
+            for flood in args.flood or FLOODS:
                 for name, tree in trees.items():
                     result = one_run(str(Path(tree).resolve()), flood, args, clip)
                     result |= {"round": round_index, "tree": name, "flood": flood}
                     print(json.dumps(result), flush=True)
                     if result["slowdown"] is not None:
                         table.setdefault((name, flood), []).append(result["slowdown"])
-    print("\ntree     flood                 slowdown per run (median frame interval, on vs off)")
+                        cores = result["daemon_cpu_cores"]
+                        cpu.setdefault((name, flood), []).append(
+                            (
+                                cores["off"] or 0.0,
+                                cores["on"] or 0.0,
+                                result["health_answered"]["on"],
+                            )
+                        )
+    print("\ntree     flood                         frame-loop slowdown per run (on vs off); "
+          "median; daemon CPU cores off -> on; health checks answered while flooded")  # fmt: skip
     for (name, flood), values in sorted(table.items()):
         shown = ", ".join(f"{100 * value:+.0f} %" for value in values)
-        print(f"{name:<8} {flood:<21} {shown}  (median {100 * statistics.median(values):+.0f} %)")
+        runs = cpu[(name, flood)]
+        cores = ", ".join(f"{off:.2f}->{on:.2f}" for off, on, _ in runs)
+        answered = " ".join(health for _, _, health in runs)
+        print(f"{name:<8} {flood:<29} {shown}; {100 * statistics.median(values):+.0f} %; "
+              f"{cores}; {answered}")  # fmt: skip
     return 0
 
 

@@ -121,6 +121,11 @@ def run(args: argparse.Namespace, config: Config) -> int:
     with signal_handlers(stop):
         started = time.monotonic()
         log.info("roadgaze listen: %s; keys %s/*", plan.describe(), keys.prefix)
+        if all_vehicles and plan.config_file is not None:
+            log.warning(
+                "roadgaze listen: with access control (roadgaze security init) a subscription "
+                "to every vehicle is denied: name the vehicle with --vehicle-id"
+            )
         try:
             session = open_session(
                 plan, wait_s=math.inf if timeout_s is None else timeout_s, stopped=stop.is_set

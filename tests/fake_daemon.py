@@ -3,7 +3,7 @@
     python tests/fake_daemon.py [--frame-s S] RUN_ARGUMENTS...
 
 Everything but the camera and the landmark model is real: signals, the Zenoh link, the monitor,
-health and the final state. The face looks at the road for 1 s, then 45 deg away for 5 s, over
+health and the final state. The face looks at the road for 1 s, then 30 deg to the right (zone away) for 5 s, over
 and over (a long-distraction alert and its clear every 6 s); each frame takes `--frame-s`
 (default 1/30 s), so a test can make a frame long enough to signal twice during it.
 """
@@ -52,14 +52,14 @@ class EndlessSource(ClosesOnExit):
 
 
 class GlancingDetector:
-    """1 s on the road, 5 s at 45 deg, repeated; each call takes `frame_s` of wall time."""
+    """1 s on the road, 5 s at -30 deg (away), repeated; each call takes `frame_s` of wall time."""
 
     def __init__(self, frame_s: float) -> None:
         self.frame_s = frame_s
 
     def detect(self, image: Any, t_s: float | None = None) -> Detection:
         time.sleep(self.frame_s)
-        yaw_deg = 0.0 if (t_s or 0.0) % 6.0 < 1.0 else 45.0
+        yaw_deg = 0.0 if (t_s or 0.0) % 6.0 < 1.0 else -30.0
         return Detection(faces=(face_at(yaw_deg),), driver_index=0)
 
     def close(self) -> None:

@@ -114,7 +114,7 @@ def test_bench_refuses_a_loop_that_would_never_end(
     ("setting", "message"),
     [
         ("monitor.critical_distraction_s=2", "must not be below long_distraction_s"),
-        ("monitor.hysteresis_deg=30", "must be below road_half_width_deg"),
+        ("monitor.hysteresis_deg=30", "must be smaller than road_half_width_deg"),
         ("monitor.min_speed_kmh=inf", "finite number"),
         ("monitor.min_speed_kmh=nan", "finite number"),
         ("monitor.min_speed_kmh=true", "found a boolean"),

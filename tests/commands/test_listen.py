@@ -14,6 +14,7 @@ import time
 from typing import Any
 
 import pytest
+import zenoh
 
 from fakes import BLANK_FRAME, alert_message, record_of
 from repo_paths import child_env
@@ -66,10 +67,14 @@ def test_hostile_payloads_are_reported_and_the_valid_alert_printed_once() -> Non
                 b'{"schema": "roadgaze.alert/1", "vehicle_id": "car-1\\ud800"}',
                 probe,  # a duplicate of seq 0
             ]
+            block = zenoh.CongestionControl.BLOCK  # the default (DROP) may lose some under load
             for payload in hostile:
-                attacker.put(ALERT_KEY, payload)
-            attacker.put(STATE_KEY, valid_state(source="cam\ud800\x1b[2J", problems=["\udfff"]))
-            attacker.put(ALERT_KEY, alert_message(1, VEHICLE).to_json_bytes())
+                attacker.put(ALERT_KEY, payload, congestion_control=block)
+            state = valid_state(source="cam\ud800\x1b[2J", problems=["\udfff"])
+            attacker.put(STATE_KEY, state, congestion_control=block)
+            attacker.put(
+                ALERT_KEY, alert_message(1, VEHICLE).to_json_bytes(), congestion_control=block
+            )
             received = [json.loads(reader.next(10.0) or "null") for _ in range(2)]
             process.send_signal(signal.SIGTERM)
             code = process.wait(timeout=20)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import zenoh
+
 from fakes import alert_message
 from repo_paths import REPO
 from roadgaze.config import ZenohConfig
@@ -28,8 +30,11 @@ def test_the_example_gets_history_then_live_alerts_and_refuses_forgeries() -> No
         try:
             reader = LineReader(process)
             lines = [reader.next(20.0) for _ in range(3)]
-            bus.put(link.keys.alert, alert_message(7, "car-9").to_json_bytes())
-            bus.put(link.keys.alert, b"[" * 50_000)
+            block = zenoh.CongestionControl.BLOCK  # the default (DROP) may lose them under load
+            bus.put(
+                link.keys.alert, alert_message(7, "car-9").to_json_bytes(), congestion_control=block
+            )
+            bus.put(link.keys.alert, b"[" * 50_000, congestion_control=block)
             link.publish_alert(alert_message(3, "car-42"))
             lines.append(reader.next(10.0))
             _, stderr = process.communicate(timeout=30)

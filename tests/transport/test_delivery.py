@@ -28,8 +28,9 @@ from zenoh_helpers import (
 )
 
 FPS = 10.0
-GLANCE = [0.0] * 10 + [45.0] * 70 + [0.0] * 20
-"""Road 1 s, a 7 s glance to 45 deg (long_distraction at 4 s, critical at 7 s), road 2 s."""
+GLANCE = [0.0] * 10 + [-30.0] * 70 + [0.0] * 20
+"""Road 1 s, a 7 s glance to -30 deg (zone away: long_distraction at 4 s, critical at 7 s), road
+2 s."""
 
 
 @contextmanager

@@ -147,10 +147,13 @@ def test_attacks_by_a_consumer_are_stopped_by_the_router(
         time.sleep(0.5)
         provider.put(keys.speed, b'{"kmh": 50}')
         assert wait_for(lambda: speed.kmh() == 50.0, timeout_s=10.0)
+        block = zenoh.CongestionControl.BLOCK  # not lost to a busy machine: denied
         for _ in range(5):  # forged speed, forged alert, forged heartbeat
-            attacker.put(keys.speed, b'{"kmh": 0}')
-            attacker.put(keys.alert, alert_message(99, VEHICLE).to_json_bytes())
-            attacker.put(f"{keys.alert}/@adv/pub/1/1/_", b"\x63\x00\x00\x00")
+            attacker.put(keys.speed, b'{"kmh": 0}', congestion_control=block)
+            forged = alert_message(99, VEHICLE).to_json_bytes()
+            attacker.put(keys.alert, forged, congestion_control=block)
+            heartbeat = f"{keys.alert}/@adv/pub/1/1/_"
+            attacker.put(heartbeat, b"\x63\x00\x00\x00", congestion_control=block)
             time.sleep(0.1)
         time.sleep(0.5)
         assert speed.kmh() == 50.0  # the consumer's 0 km/h never reached the daemon

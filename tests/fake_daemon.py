@@ -3,9 +3,9 @@
     python tests/fake_daemon.py [--frame-s S] RUN_ARGUMENTS...
 
 Everything but the camera and the landmark model is real: signals, the Zenoh link, the monitor,
-health and the final state. The face looks at the road for 1 s, then 30 deg to the right (zone away) for 5 s, over
-and over (a long-distraction alert and its clear every 6 s); each frame takes `--frame-s`
-(default 1/30 s), so a test can make a frame long enough to signal twice during it.
+health and the final state. The face looks at the road for 1 s, then 30 deg to the right (zone
+away) for 5 s, over and over (a long-distraction alert and its clear every 6 s); each frame takes
+`--frame-s` (default 1/30 s), so a test can make a frame long enough to signal twice during it.
 """
 
 from __future__ import annotations

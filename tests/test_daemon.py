@@ -289,12 +289,7 @@ def test_daemon_keeps_monitoring_while_the_peer_is_unreachable(glance_clip: Path
     port = free_port()
     daemon = run_daemon_process(str(glance_clip), port)
     try:
-        assert daemon.stderr is not None
-        started = LineReader(daemon, daemon.stderr)
-        line = ""
-        while "roadgaze run: source" not in line:
-            line = started.next(60.0) or ""
-            assert line or daemon.poll() is None, "daemon did not start"
+        LineReader(daemon, daemon.stderr).until("roadgaze run: source", 60.0)
         time.sleep(3.0)  # monitoring while nothing listens on the port
         assert daemon.poll() is None
         with router(port) as session:
@@ -571,13 +566,8 @@ def test_run_and_listen_without_endpoint_flags_find_each_other(with_router: bool
         )  # fmt: skip
         listener: subprocess.Popen[str] | None = None
         try:
-            assert daemon.stderr is not None
             daemon_log = LineReader(daemon, daemon.stderr)
-            lines: list[str] = []
-            while not any("roadgaze run: source" in line for line in lines):
-                line = daemon_log.next(60.0)
-                assert line is not None, "daemon did not start"
-                lines.append(line)
+            lines = daemon_log.until("roadgaze run: source", 60.0)
             time.sleep(1.0)
             while (line := daemon_log.next(0.1)) is not None:
                 lines.append(line)
@@ -590,7 +580,8 @@ def test_run_and_listen_without_endpoint_flags_find_each_other(with_router: bool
             stdout, listen_log = listener.communicate(timeout=60)
             daemon.send_signal(signal.SIGTERM)
             assert daemon.wait(timeout=30) == 0
-            lines += (daemon.stderr.read() or "").splitlines()
+            while (line := daemon_log.next(1.0)) is not None:
+                lines.append(line)
         finally:
             stop_process(daemon)
             if listener is not None:

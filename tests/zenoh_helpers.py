@@ -87,6 +87,17 @@ class LineReader:
         except queue.Empty:
             return None
 
+    def until(self, text: str, timeout_s: float) -> list[str]:
+        """The lines read up to and including the first containing `text`; AssertionError when
+        none comes within `timeout_s`."""
+        deadline = time.monotonic() + timeout_s
+        lines: list[str] = []
+        while not lines or text not in lines[-1]:
+            line = self.next(max(0.0, deadline - time.monotonic()))
+            assert line is not None, f"no line with {text!r} in {timeout_s} s; got {lines[-5:]}"
+            lines.append(line)
+        return lines
+
 
 def stop_process(process: subprocess.Popen[str], timeout_s: float = 10.0) -> None:
     if process.poll() is None:

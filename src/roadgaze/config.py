@@ -318,12 +318,13 @@ def _format_validation_error(error: ValidationError, origin: str) -> str:
     for item in error.errors():
         where = ".".join(str(p) for p in item["loc"])
         found = item.get("input")
+        message = item["msg"] if len(item["msg"]) <= 300 else item["msg"][:300] + "..."
         if isinstance(found, dict):  # a check across fields: the message names them
-            problems.append(f"{where}: {item['msg']}")
+            problems.append(f"{where}: {message}")
             continue
         text = repr(found)
         text = text if len(text) <= 80 else f"{text[:60]}... ({len(text)} characters)"
-        problems.append(f"{where}: {item['msg']} (found {text})")
+        problems.append(f"{where}: {message} (found {text})")
     return f"bad configuration from {origin}: " + "; ".join(problems)
 
 

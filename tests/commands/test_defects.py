@@ -4,8 +4,6 @@ written. `replay` runs in this process with a scripted source and detector (no M
 from __future__ import annotations
 
 import hashlib
-import logging
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -18,15 +16,7 @@ from roadgaze.cli import main
 FRAMES = 60
 
 
-@pytest.fixture(autouse=True)
-def restore_logging() -> Iterator[None]:
-    """`main()` points roadgaze's log handler at the captured stderr; undo it afterwards."""
-    logger = logging.getLogger("roadgaze")
-    handlers, level, propagate = list(logger.handlers), logger.level, logger.propagate
-    yield
-    logger.handlers[:] = handlers
-    logger.setLevel(level)
-    logger.propagate = propagate
+pytestmark = pytest.mark.usefixtures("restore_logging")
 
 
 @pytest.fixture
@@ -149,10 +139,10 @@ def test_a_5000_digit_number_in_a_file_or_the_environment_is_one_line(
 @pytest.mark.parametrize(
     ("rows", "message"),
     [
-        ("file,yaw_deg\na.jpg\n", "must be finite numbers"),  # a short row: no yaw at all
-        ("file,yaw_deg\na.jpg,\n", "must be finite numbers"),
-        ("file,yaw_deg\na.jpg,nan\n", "must be finite numbers"),
-        ("file,yaw_deg,pitch_deg\na.jpg,10,inf\n", "must be finite numbers"),
+        ("file,yaw_deg\na.jpg\n", "must be numbers (finite)"),  # a short row: no yaw at all
+        ("file,yaw_deg\na.jpg,\n", "must be numbers (finite)"),
+        ("file,yaw_deg\na.jpg,nan\n", "must be numbers (finite)"),
+        ("file,yaw_deg,pitch_deg\na.jpg,10,inf\n", "must be numbers (finite)"),
         ("file,yaw_deg\nmissing1.jpg,10\nmissing2.jpg,20\n", "none of the 2 images"),
     ],
 )

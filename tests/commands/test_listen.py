@@ -161,12 +161,7 @@ def test_listen_stopped_by_a_signal_exits_0(number: int) -> None:
     with router(port):
         process = listen(port)
         try:
-            assert process.stderr is not None
-            errors = LineReader(process, process.stderr)
-            line = ""
-            while "connected to router" not in line:
-                line = errors.next(30.0) or ""
-                assert line or process.poll() is None, "listen did not connect"
+            LineReader(process, process.stderr).until("connected to router", 30.0)
             process.send_signal(number)
             code = process.wait(timeout=20)
         finally:

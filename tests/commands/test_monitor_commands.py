@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import json
-import logging
-from collections.abc import Iterator
 
 import jsonschema
 import pytest
@@ -12,16 +10,7 @@ import pytest
 from roadgaze.cli import main
 from roadgaze.commands.listen import _vehicle_of, format_pretty
 
-
-@pytest.fixture(autouse=True)
-def restore_logging() -> Iterator[None]:
-    """`main()` points roadgaze's log handler at the captured stderr; undo it afterwards."""
-    logger = logging.getLogger("roadgaze")
-    handlers, level, propagate = list(logger.handlers), logger.level, logger.propagate
-    yield
-    logger.handlers[:] = handlers
-    logger.setLevel(level)
-    logger.propagate = propagate
+pytestmark = pytest.mark.usefixtures("restore_logging")
 
 
 def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> None:

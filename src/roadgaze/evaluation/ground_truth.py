@@ -49,7 +49,7 @@ def load_ground_truth(dataset_dir: Path) -> tuple[list[GroundTruth], int]:
                         raise ValueError("not finite")
                 except (TypeError, ValueError):
                     raise DatasetError(
-                        f"{csv_path}:{line}: yaw_deg/pitch_deg must be finite numbers, found "
+                        f"{csv_path}:{line}: yaw_deg/pitch_deg must be numbers (finite), found "
                         f"{str(row.get('yaw_deg'))[:40]!r}/{str(row.get('pitch_deg'))[:40]!r}"
                     ) from None
                 if not row.get("file"):

@@ -155,7 +155,7 @@ VALUE_TEXTS = (
 )
 
 
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=250, deadline=None)
 @given(st.sampled_from(FIELDS), VALUE_TEXTS)
 def test_fuzz_any_value_in_any_field_is_a_config_error_or_a_finite_config(
     field: str, text: str

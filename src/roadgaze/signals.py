@@ -38,16 +38,16 @@ class StopFlag:
 
 
 @contextmanager
-def signal_handlers(stop: StopFlag) -> Iterator[None]:
+def signal_handlers(stop: StopFlag, doing: str = "finishing the current frame") -> Iterator[None]:
     """SIGINT/SIGTERM/SIGHUP set `stop` (the current frame is finished); a second one exits at
-    once (exit code 1)."""
+    once (exit code 1). `doing` says in the log what happens next."""
 
     def on_signal(number: int, frame: FrameType | None) -> None:
         name = signal.Signals(number).name
         if stop.is_set():
             log.warning("second %s: exiting without waiting", name)
             raise SystemExit(1)
-        log.info("%s received: finishing the current frame", name)
+        log.info("%s received: %s", name, doing)
         stop.set(name)
 
     previous = {number: signal.signal(number, on_signal) for number in STOP_SIGNALS}

@@ -120,7 +120,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     endpoints = ", ".join(plan.connect + plan.listen) or "no endpoint"
     timeout_s = args.timeout if args.timeout is not None else 5.0 if args.query_state else None
     stop = StopFlag()
-    with signal_handlers(stop):
+    with signal_handlers(stop, doing="stopping"):
         started = time.monotonic()
         log.info("roadgaze listen: %s; keys %s/*", plan.describe(), keys.prefix)
         if all_vehicles and plan.config_file is not None:

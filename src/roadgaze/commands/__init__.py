@@ -3,6 +3,7 @@
 from types import ModuleType
 
 from roadgaze.commands import (
+    batch,
     bench,
     demo,
     estimate,
@@ -22,6 +23,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     run,
     listen,
     replay,
+    batch,
     bench,
     evaluate,
     estimate,

@@ -47,7 +47,7 @@ def test_replay_to_a_full_disk_is_one_line_and_keeps_the_other_outputs(
     code = main(["replay", str(scripted), "--out", str(records), "--csv", "/dev/full",
                  "--no-progress"])  # fmt: skip
     assert code == 2
-    assert "No space left on device" in one_error_line(capsys)
+    assert one_error_line(capsys).endswith("No space left on device: /dev/full")
     lines = records.read_text().splitlines()
     assert len(lines) >= 1 and '"frame": 0' in lines[0]  # what was written so far is kept
 

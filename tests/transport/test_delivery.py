@@ -84,9 +84,14 @@ def test_router_killed_mid_glance_every_alert_arrives_in_order_soon_after_restar
             assert wait_for(lambda: link.status().connected, timeout_s=10.0)
             assert wait_for(lambda: len(listener.seqs()) >= 3, timeout_s=5.0)
             arrived = max(arrival for arrival, _ in listener.alerts[1:3])
-            # The router process starts, loads Python and Zenoh, then listens: an upper bound.
-            after_s = arrived - router.spawned_at
-            print(f"outage alerts arrived {after_s:.3f} s after the router process was started")
+            # The figure: from the daemon's link coming back (its transport event). The
+            # router process's start (Python and Zenoh loaded, then it listens) is printed too;
+            # on a loaded machine that start alone can take seconds.
+            after_s = arrived - link.link_state.changed_at
+            print(
+                f"outage alerts arrived {after_s:.3f} s after the daemon's link came back, "
+                f"{arrived - router.spawned_at:.3f} s after the router process was started"
+            )
             assert listener.seqs() == [0, 1, 2]
             assert listener.kinds() == [
                 "long_distraction:warning",

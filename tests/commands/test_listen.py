@@ -119,7 +119,19 @@ def test_query_state_rejects_a_hostile_answer_and_flags_a_second_answerer() -> N
         )  # fmt: skip
         assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
         assert "rejected" in result.stderr and "no answer" in result.stderr
+        valid = attacker.declare_queryable(
+            STATE_KEY, lambda query: query.reply(STATE_KEY, valid_state())
+        )
+        result = subprocess.run(
+            [sys.executable, "-m", "roadgaze", "listen", "--query-state", "--vehicle-id", VEHICLE,
+             "--zenoh-connect", endpoint(port), "--timeout", "5"],
+            capture_output=True, text=True, timeout=60, env=child_env(), check=False,
+        )  # fmt: skip
+        valid.undeclare()
         deep.undeclare()
+        # A hostile answer beside the daemon's: the health check is not to be trusted.
+        assert result.returncode == 3 and "Traceback" not in result.stderr, result.stderr
+        assert "1 answer(s) rejected" in result.stderr and "status=running" in result.stdout
         answers = [
             attacker.declare_queryable(STATE_KEY, lambda q: q.reply(STATE_KEY, valid_state()))
             for _ in range(2)

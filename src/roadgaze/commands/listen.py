@@ -307,6 +307,7 @@ class _Listener:
 
         deadline = time.monotonic() + timeout_s
         answers: dict[str, list[str]] = {}
+        rejected = 0
         while not answers and time.monotonic() < deadline:
             # Right after opening, the routes to the queryable may not be known yet: ask again.
             wait_s = max(0.05, min(1.0, deadline - time.monotonic()))
@@ -324,6 +325,7 @@ class _Listener:
                     checked = self.checker.check("state", key, reply.ok.payload.to_bytes())
                 except PayloadError as exc:
                     _say(f"state answer on {printable(key, 80)} rejected: {printable(str(exc))}")
+                    rejected += 1
                     continue
                 answers.setdefault(checked.vehicle_id, []).append(str(checked.payload["status"]))
                 self._show("state", key, checked.vehicle_id, checked.payload)
@@ -335,6 +337,12 @@ class _Listener:
             _say(
                 f"suspicious: several answers for one vehicle {twice}: another process answers "
                 "on its state key (see docs/security.md)"
+            )
+            return 3
+        if rejected:
+            _say(
+                f"suspicious: {rejected} answer(s) rejected beside the valid one: another process "
+                "answers on the state key (see docs/security.md)"
             )
             return 3
         statuses = [status for found in answers.values() for status in found]

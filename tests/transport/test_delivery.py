@@ -12,6 +12,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+import pytest
 import zenoh
 
 from fakes import ListSource, ScriptedDetector, alert_message
@@ -50,7 +51,11 @@ def daemon_link(port: int, **zenoh_settings: Any) -> Iterator[tuple[ZenohLink, l
         yield link, [health, BusPublisher(keys.vehicle_id, link)]
 
 
-def test_router_killed_mid_glance_every_alert_arrives_in_order_soon_after_restart() -> None:
+@pytest.mark.parametrize("mode", ["peer", "client"])
+def test_router_killed_mid_glance_every_alert_arrives_in_order_soon_after_restart(
+    mode: str,
+) -> None:
+    """The issue lost `long_distraction` and `cleared` in peer mode, 5 alerts in client mode."""
     port = free_port()
     router = RouterProcess(port)
     router.start()
@@ -65,7 +70,7 @@ def test_router_killed_mid_glance_every_alert_arrives_in_order_soon_after_restar
 
     try:
         with (
-            daemon_link(port) as (link, sinks),
+            daemon_link(port, mode=mode) as (link, sinks),
             zenoh.open(client_config([endpoint(port)])) as consumer,
         ):
             listener = AdvancedListener(consumer, link.keys.alert)

@@ -106,27 +106,27 @@ def test_pretty_printing_survives_lone_surrogates() -> None:
     assert "state  car-1 status=running" in stdout and "\\ud800" in stdout
 
 
+def query_state(port: int, timeout_s: float) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "roadgaze", "listen", "--query-state", "--vehicle-id", VEHICLE,
+         "--zenoh-connect", endpoint(port), "--timeout", str(timeout_s)],
+        capture_output=True, text=True, timeout=60, env=child_env(), check=False,
+    )  # fmt: skip
+
+
 def test_query_state_rejects_a_hostile_answer_and_flags_a_second_answerer() -> None:
     port = free_port()
     with router(port) as attacker:
         deep = attacker.declare_queryable(
             STATE_KEY, lambda query: query.reply(STATE_KEY, b"[" * 60_000)
         )
-        result = subprocess.run(
-            [sys.executable, "-m", "roadgaze", "listen", "--query-state", "--vehicle-id", VEHICLE,
-             "--zenoh-connect", endpoint(port), "--timeout", "3"],
-            capture_output=True, text=True, timeout=60, env=child_env(), check=False,
-        )  # fmt: skip
+        result = query_state(port, 3)
         assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
         assert "rejected" in result.stderr and "no answer" in result.stderr
         valid = attacker.declare_queryable(
             STATE_KEY, lambda query: query.reply(STATE_KEY, valid_state())
         )
-        result = subprocess.run(
-            [sys.executable, "-m", "roadgaze", "listen", "--query-state", "--vehicle-id", VEHICLE,
-             "--zenoh-connect", endpoint(port), "--timeout", "5"],
-            capture_output=True, text=True, timeout=60, env=child_env(), check=False,
-        )  # fmt: skip
+        result = query_state(port, 5)
         valid.undeclare()
         deep.undeclare()
         # A hostile answer beside the daemon's: the health check is not to be trusted.
@@ -136,11 +136,7 @@ def test_query_state_rejects_a_hostile_answer_and_flags_a_second_answerer() -> N
             attacker.declare_queryable(STATE_KEY, lambda q: q.reply(STATE_KEY, valid_state()))
             for _ in range(2)
         ]
-        result = subprocess.run(
-            [sys.executable, "-m", "roadgaze", "listen", "--query-state", "--vehicle-id", VEHICLE,
-             "--zenoh-connect", endpoint(port), "--timeout", "5"],
-            capture_output=True, text=True, timeout=60, env=child_env(), check=False,
-        )  # fmt: skip
+        result = query_state(port, 5)
         for answer in answers:
             answer.undeclare()
     assert result.returncode == 3, result.stderr

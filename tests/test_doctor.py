@@ -174,7 +174,9 @@ def test_an_unreachable_connect_endpoint_and_a_session_that_cannot_open_fail(
 ) -> None:
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     config = Config.model_validate({"zenoh": {"connect": [endpoint]}})
-    monkeypatch.setattr(service, "open_session_problem", lambda config: "cannot bind")
+    monkeypatch.setattr(
+        service, "open_session_problem", lambda config: ("mode peer", "cannot bind")
+    )
     session, connect = check_zenoh(config)
     assert (session.status, connect.status) == (Status.FAIL, Status.FAIL)
     assert "cannot bind" in session.detail and endpoint in connect.detail

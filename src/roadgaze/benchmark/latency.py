@@ -54,7 +54,7 @@ class YawLatencyProbe:
     """A Zenoh subscriber to the yaw key; records receipt time minus capture stamp per message."""
 
     def __init__(self, config: Config, stamps: CaptureStamps) -> None:
-        from roadgaze.transport import Keys, open_session
+        from roadgaze.transport import Keys, open_session, plan_session
 
         self.keys = Keys.from_config(config.zenoh)
         self._stamps = stamps
@@ -66,7 +66,7 @@ class YawLatencyProbe:
         self._session: Any = None
         self._subscriber: Any = None
         try:
-            self._session = open_session(config.zenoh)
+            self._session = open_session(plan_session(config.zenoh, "consumer", mode="peer"))
             self._subscriber = self._session.declare_subscriber(self.keys.yaw, self._on_sample)
         except BaseException:
             self.close()

@@ -15,6 +15,7 @@ from roadgaze.commands import (
     replay,
     run,
     schema,
+    security,
     synth,
 )
 
@@ -30,6 +31,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     synth,
     model,
     schema,
+    security,
     paper,
     doctor,
 )

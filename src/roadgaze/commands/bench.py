@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from roadgaze.commands.options import common_options
+from roadgaze.commands.options import check_seconds, common_options
 from roadgaze.config import Config
 
 if TYPE_CHECKING:
@@ -125,8 +125,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
 
     if args.warmup < 0:
         raise ConfigError(f"--warmup must be >= 0, found {args.warmup}")
-    if args.loop_seconds is not None and args.loop_seconds <= 0:
-        raise ConfigError(f"--loop-seconds must be > 0, found {args.loop_seconds}")
+    check_seconds("--loop-seconds", args.loop_seconds)
     if args.repeat < 1:
         raise ConfigError(f"--repeat must be at least 1, found {args.repeat}")
     rss_start_mb = resident_mb()

@@ -96,22 +96,25 @@ def endpoint_reachable(endpoint: str, timeout_s: float = ENDPOINT_TIMEOUT_S) -> 
         return exc.strerror or str(exc) or type(exc).__name__
 
 
-def open_session_problem(config: Config) -> str | None:
-    """None when a Zenoh session opens (and closes) with the configured settings."""
+def open_session_problem(config: Config) -> tuple[str, str | None]:
+    """The session `roadgaze run` would open (mode and endpoints, the rendezvous included) and
+    None when it opens (and closes), else the problem."""
     from roadgaze.errors import TransportError
-    from roadgaze.transport import open_session
+    from roadgaze.transport import open_session, plan_session
 
+    plan = plan_session(config.zenoh, "daemon")
+    listen, connect = list(plan.listen) or "-", list(plan.connect) or "-"
+    where = f"mode {plan.mode}, listen {listen}, connect {connect}"
     try:
-        open_session(config.zenoh).close()
+        open_session(plan).close()
     except TransportError as exc:
-        return str(exc)
-    return None
+        return where, str(exc)
+    return where, None
 
 
 def check_zenoh(config: Config) -> list[Check]:
     zenoh = config.zenoh
-    where = f"mode {zenoh.mode}, listen {zenoh.listen or '-'}, connect {zenoh.connect or '-'}"
-    problem = open_session_problem(config)
+    where, problem = open_session_problem(config)
     checks = []
     if problem is None:
         checks.append(Check("zenoh", Status.OK, f"a session opens ({where})"))

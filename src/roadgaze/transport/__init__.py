@@ -16,6 +16,7 @@ from roadgaze.transport.messages import (
     json_schemas,
 )
 from roadgaze.transport.publisher import BusPublisher, MessageLink
+from roadgaze.transport.router import DEFAULT_LISTEN, Router, RouterSettings, router_config
 from roadgaze.transport.session import (
     build_zenoh_config,
     open_session,
@@ -26,6 +27,7 @@ from roadgaze.transport.speed import SpeedInput, parse_speed_kmh
 
 __all__ = [
     "ALERT_SCHEMA",
+    "DEFAULT_LISTEN",
     "MESSAGE_MODELS",
     "STATE_SCHEMA",
     "YAW_SCHEMA",
@@ -35,6 +37,8 @@ __all__ = [
     "Keys",
     "MessageLink",
     "MonitorSnapshot",
+    "Router",
+    "RouterSettings",
     "SpeedInput",
     "StateMessage",
     "TransportStatus",
@@ -44,6 +48,7 @@ __all__ = [
     "json_schemas",
     "open_session",
     "parse_speed_kmh",
+    "router_config",
     "session_config_dict",
     "zenoh_error_text",
 ]

@@ -74,15 +74,14 @@ def run_daemon(
     stops monitoring (see `ZenohLink`). Under systemd (`$NOTIFY_SOCKET`) it sends READY, WATCHDOG
     and STOPPING notifications (see `roadgaze.supervision`).
     """
+    from roadgaze import capture
+    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.supervision import Supervisor
+
     stop = stop if stop is not None else StopFlag()
     with ExitStack() as stack:
         if handle_signals:
             stack.enter_context(signal_handlers(stop))
-        # Imported once the handlers are in: a SIGTERM during start-up is a clean stop.
-        from roadgaze import capture
-        from roadgaze.pipeline import Pipeline, create_detector
-        from roadgaze.supervision import Supervisor
-
         supervisor = stack.enter_context(
             Supervisor.from_environment(stop, config.capture.reconnect_max_s)
         )

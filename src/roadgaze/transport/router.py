@@ -14,11 +14,11 @@ import logging
 import threading
 from dataclasses import dataclass
 from pathlib import Path
-from types import TracebackType
 from typing import Any, Self
 
 from roadgaze.errors import TransportError
 from roadgaze.transport.session import zenoh_error_text
+from roadgaze.types import ClosesOnExit
 
 log = logging.getLogger("roadgaze.router")
 
@@ -93,8 +93,8 @@ def router_config(settings: RouterSettings) -> RouterConfig:
     return RouterConfig(zenoh_config=zconf, listen=listen, multicast_scouting=bool(multicast))
 
 
-class Router:
-    """A Zenoh session in router mode; a context manager. Logs sessions as they come and go.
+class Router(ClosesOnExit):
+    """A Zenoh session in router mode, opened by `with`; logs sessions as they come and go.
 
     Raises TransportError on entry when an endpoint cannot be listened on (in use, unknown
     host or protocol, TLS files missing).
@@ -142,14 +142,6 @@ class Router:
             extra={"listen": list(self.config.listen), "zid": str(self._session.zid())},
         )
         return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
 
     def _describe(self, zid: str) -> str:
         """`from ADDRESS` (and `as NAME` with an authenticated link) of a session's links."""

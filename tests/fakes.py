@@ -92,10 +92,12 @@ class FakeCamera:
         self.log.append("release")
 
 
-def face_at(yaw_deg: float) -> FaceFeatures:
-    """A face whose boundaries and centre come from the paper's forward model."""
+def face_at(yaw_deg: float, pitch_deg: float | None = None) -> FaceFeatures:
+    """A face whose boundaries and centre come from the paper's forward model; `pitch_deg` is
+    MediaPipe's matrix pitch (None: no matrix)."""
     projected = forward_model(yaw_deg, half_width_px=80.0, pivot_x_px=320.0)
     return FaceFeatures(
+        mediapipe_pitch_deg=pitch_deg,
         x_left_px=float(projected.x_left),
         x_right_px=float(projected.x_right),
         x_center_px=float(projected.x_center),
@@ -107,10 +109,14 @@ def face_at(yaw_deg: float) -> FaceFeatures:
 
 
 class ScriptedDetector:
-    """Fake `LandmarkDetector`: the true yaw per call (None: no face), checking time order."""
+    """Fake `LandmarkDetector`: the true yaw per call (None: no face), checking time order;
+    optionally MediaPipe's matrix pitch per call."""
 
-    def __init__(self, yaws_deg: list[float | None]) -> None:
+    def __init__(
+        self, yaws_deg: list[float | None], pitches_deg: list[float] | None = None
+    ) -> None:
         self.yaws_deg = list(yaws_deg)
+        self.pitches_deg = pitches_deg
         self.calls: list[float | None] = []
         self.closed = False
 
@@ -120,7 +126,8 @@ class ScriptedDetector:
         self.calls.append(t_s)
         if yaw_deg is None:
             return Detection(faces=(), driver_index=None)
-        return Detection(faces=(face_at(yaw_deg),), driver_index=0)
+        pitch_deg = None if self.pitches_deg is None else self.pitches_deg[len(self.calls) - 1]
+        return Detection(faces=(face_at(yaw_deg, pitch_deg),), driver_index=0)
 
     def close(self) -> None:
         self.closed = True
@@ -173,6 +180,18 @@ BLANK_FRAME = Frame(0, 0.0, np.zeros((4, 4, 3), np.uint8))
 """A frame for sinks that ignore the image."""
 
 
+FACE = FaceFeatures(
+    x_left_px=100.0,
+    x_right_px=180.0,
+    x_center_px=150.0,
+    roll_deg=10.0,
+    box_px=(95.0, 60.0, 185.0, 170.0),
+    quality=0.9,
+    landmarks_px=np.array([[100, 100, 0], [180, 110, 0], [150, 160, 0]], np.float32),
+)
+"""A face 80 px wide with its centre right of the middle (for writer and record tests)."""
+
+
 def record_of(
     sample: PoseSample, verdict: Verdict | None = None, alerts: tuple[Alert, ...] = ()
 ) -> FrameRecord:
@@ -223,3 +242,15 @@ class FakeNotifySocket:
         self._stop.set()
         self._thread.join(timeout=2.0)
         self._socket.close()
+
+
+def die_on_crash_drives(task: Any) -> Any:
+    """A fleet task function for worker processes: the process dies on drives named `crash*`
+    (as on a crash in native code); other drives succeed at once with one frame."""
+    import os
+
+    from roadgaze.fleet import DriveResult
+
+    if task.drive.drive_id.startswith("crash"):
+        os._exit(70)
+    return DriveResult.of(task.drive, "ok", frames=1, duration_s=0.1)

@@ -15,11 +15,12 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from roadgaze.errors import ConfigError
 
 if TYPE_CHECKING:
+    from roadgaze.monitor.zones import ZoneMap
     from roadgaze.pose.geometry import FaceModelConstants
 
 ENV_PREFIX = "ROADGAZE__"
@@ -41,20 +42,48 @@ class ModelConfig(_Section):
     download_timeout_s: float = Field(default=60.0, gt=0)
 
 
+YAW_MODEL_NAMES = ("full_range", "cylindrical", "ellipsoidal", "ce", "center_ce", "boundary_ce")
+"""Values of `geometry.model`: the service's full-range yaw, then the paper's five models."""
+
+
 class GeometryConfig(_Section):
     """The face model turning boundaries and centre into yaw (Narayanan et al. 2014)."""
 
-    model: Literal["cylindrical", "ellipsoidal", "ce", "center_ce", "boundary_ce"] = "center_ce"
+    model: Literal["full_range", "cylindrical", "ellipsoidal", "ce", "center_ce", "boundary_ce"] = (
+        "full_range"
+    )
+    """`full_range`: Center-CE blended into the cylinder where MediaPipe's own yaw says the head
+    is turned beyond Center-CE's range (docs/pose.md); any other value: that paper model alone."""
     alpha: float = Field(default=0.25, ge=0)
     beta: float = Field(default=1.25, gt=1)
     gamma_c: float = Field(default=0.1269, ge=0)
     gamma_b: float = Field(default=0.5774, ge=0)
+    full_range_cue_deg: tuple[float, float] = (20.0, 90.0)
+    """|MediaPipe matrix yaw| where the full-range blend starts and where it would reach the
+    cylinder (smoothstep between)."""
+
+    @field_validator("full_range_cue_deg")
+    @classmethod
+    def _ordered_cue(cls, value: tuple[float, float]) -> tuple[float, float]:
+        if not 0.0 <= value[0] < value[1]:
+            raise ValueError(f"needs 0 <= start < end, found {list(value)}")
+        return value
 
     def face_constants(self) -> FaceModelConstants:
         """The constants as the yaw models take them."""
         from roadgaze.pose.geometry import FaceModelConstants
 
         return FaceModelConstants(self.alpha, self.beta, self.gamma_c, self.gamma_b)
+
+
+class PoseConfig(_Section):
+    """Head pitch (docs/pose.md); the yaw model is `[geometry] model`."""
+
+    pitch_model: Literal["matrix", "geometric"] = "matrix"
+    """`matrix`: MediaPipe's facial-transformation-matrix pitch with `pitch_down_gain` below the
+    neutral (the default, better by measurement); `geometric`: the vertical CE model (P4)."""
+    pitch_down_gain: float = Field(default=1.48, ge=1.0, le=3.0)
+    """Below the neutral pose the matrix pitch's deviation is multiplied by this (1: off)."""
 
 
 class LandmarksConfig(_Section):
@@ -83,12 +112,21 @@ class CaptureConfig(_Section):
 
 
 class SmoothingConfig(_Section):
-    """Constant-velocity Kalman smoother of yaw."""
+    """The online smoother of yaw and pitch (constant-velocity Kalman) and the offline RTS pass."""
 
     measurement_std_deg: float = Field(default=3.0, gt=0)
-    """Standard deviation of one raw Center-CE measurement."""
-    acceleration_std_dps2: float = Field(default=200.0, gt=0)
-    """White-noise yaw acceleration driving the constant-velocity model."""
+    """Noise of one raw measurement until it is measured from the series, and the least noise the
+    outlier gate assumes."""
+    min_measurement_std_deg: float = Field(default=0.2, gt=0)
+    """Floor of the measured noise."""
+    noise_window: int = Field(default=31, ge=3, le=1000)
+    """Residuals (frames) the measured noise is taken over (about 2 s at 15 fps)."""
+    min_noise_samples: int = Field(default=8, ge=1)
+    """Residuals needed before the measured noise replaces `measurement_std_deg`."""
+    acceleration_std_dps2: float = Field(default=300.0, gt=0)
+    """White-noise angular acceleration driving the constant-velocity model."""
+    clamp_window_s: float = Field(default=0.5, gt=0)
+    """The estimate stays within the raw values of the last this many seconds (offline: +-half)."""
     gate_sigma: float = Field(default=4.0, gt=0)
     """Reject a measurement whose innovation exceeds this many standard deviations."""
     max_rejections: int = Field(default=3, ge=1)
@@ -98,16 +136,72 @@ class SmoothingConfig(_Section):
     initial_std_deg: float = Field(default=3.0, gt=0)
     initial_rate_std_dps: float = Field(default=60.0, gt=0)
 
+    @model_validator(mode="after")
+    def _window_holds_enough(self) -> SmoothingConfig:
+        if self.min_noise_samples > self.noise_window:
+            raise ValueError(
+                f"min_noise_samples ({self.min_noise_samples}) must not exceed noise_window "
+                f"({self.noise_window})"
+            )
+        return self
+
+
+class ZoneConfig(_Section):
+    """One glance zone: a rectangle in yaw and pitch relative to the neutral pose, degrees."""
+
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]{0,31}$")
+    yaw_deg: tuple[float, float]
+    """[min, max], > 0 = the driver's own left."""
+    pitch_deg: tuple[float, float]
+    """[min, max], > 0 = up."""
+
+    @field_validator("yaw_deg", "pitch_deg")
+    @classmethod
+    def _ordered(cls, value: tuple[float, float]) -> tuple[float, float]:
+        if not value[0] <= value[1]:
+            raise ValueError(f"needs [min, max] with min <= max, found {list(value)}")
+        return value
+
+
+def _default_zones() -> list[ZoneConfig]:
+    return [
+        ZoneConfig(name="lap", yaw_deg=(-25.0, 25.0), pitch_deg=(-90.0, -18.0)),
+        ZoneConfig(name="cluster", yaw_deg=(-15.0, 15.0), pitch_deg=(-18.0, -10.0)),
+        ZoneConfig(name="centre_stack", yaw_deg=(-55.0, -15.0), pitch_deg=(-50.0, -5.0)),
+        ZoneConfig(name="left_mirror", yaw_deg=(20.0, 75.0), pitch_deg=(-25.0, 15.0)),
+        ZoneConfig(name="right_mirror", yaw_deg=(-85.0, -40.0), pitch_deg=(-25.0, 15.0)),
+    ]
+
 
 class MonitorConfig(_Section):
-    """Inattention monitor thresholds (defaults and their sources: docs/monitor.md)."""
+    """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)
+    """The road zone is left beyond this |yaw - neutral| and entered again within
+    `road_half_width_deg - hysteresis_deg`."""
     hysteresis_deg: float = Field(default=5.0, ge=0)
+    """Every zone is kept until the angles leave its rectangle grown by this."""
+    road_pitch_deg: tuple[float, float] = (-10.0, 15.0)
+    """Pitch relative to the neutral within which the road zone is entered (left beyond the
+    limits grown by `hysteresis_deg`)."""
+    zones: list[ZoneConfig] = Field(default_factory=_default_zones, max_length=32)
+    """The other zones, in priority order after the road (first match wins; nothing: away)."""
+    driving_related_zones: list[str] = Field(
+        default_factory=lambda: ["left_mirror", "right_mirror"]
+    )
+    """Zones whose time counts as off road (VATS, eyes_on_road) but does not run the
+    long-distraction timer."""
+    driving_glance_max_s: float | None = Field(default=4.0, gt=0)
+    """A continuous stay in a driving-related zone this long is a stare, not a glance: it counts as
+    distraction from its start (fail-safe: a long look out of the side window is not excused as a
+    mirror check); None: never."""
     neutral_yaw_deg: float | None = None
     """Fixed road-ahead yaw; None learns it online from on-road samples."""
+    neutral_pitch_deg: float | None = None
+    """Fixed road-ahead pitch; None learns it online from on-road samples."""
     neutral_time_constant_s: float = Field(default=60.0, gt=0)
     neutral_limit_deg: float = Field(default=20.0, ge=0)
+    neutral_pitch_limit_deg: float = Field(default=20.0, ge=0)
     long_distraction_s: float = Field(default=3.0, gt=0)
     critical_distraction_s: float = Field(default=6.0, gt=0)
     vats_window_s: float = Field(default=30.0, gt=0)
@@ -116,8 +210,47 @@ class MonitorConfig(_Section):
     unavailable_s: float = Field(default=2.0, gt=0)
     turn_away_deg: float | None = Field(default=None, gt=0)
     """A face lost while |yaw - neutral| exceeded this counts as turned away, not unavailable;
-    None: a face lost while the head was off road (past the road-ahead limit) is turned away."""
+    None: a face lost while the head was off road (outside the road zone) is turned away."""
     min_speed_kmh: float = Field(default=20.0, ge=0)
+
+    @field_validator("road_pitch_deg")
+    @classmethod
+    def _ordered_pitch(cls, value: tuple[float, float]) -> tuple[float, float]:
+        if not value[0] <= value[1]:
+            raise ValueError(f"needs [min, max] with min <= max, found {list(value)}")
+        return value
+
+    @model_validator(mode="after")
+    def _consistent_zones(self) -> MonitorConfig:
+        if self.hysteresis_deg >= self.road_half_width_deg:
+            raise ValueError(
+                f"hysteresis_deg ({self.hysteresis_deg}) must be smaller than "
+                f"road_half_width_deg ({self.road_half_width_deg})"
+            )
+        names = [zone.name for zone in self.zones]
+        reserved = sorted({"road", "away"} & set(names))
+        if reserved or len(set(names)) != len(names):
+            raise ValueError(f"zone names must be unique and not 'road' or 'away', found {names}")
+        unknown = sorted(set(self.driving_related_zones) - set(names))
+        if unknown:
+            raise ValueError(
+                f"driving_related_zones names zones that are not configured: {unknown} "
+                f"(zones: {names})"
+            )
+        return self
+
+    def zone_map(self) -> ZoneMap:
+        """The zones as the monitor classifies with them, the road first."""
+        from roadgaze.monitor.zones import ROAD, Zone, ZoneMap
+
+        road_yaw = self.road_half_width_deg - self.hysteresis_deg
+        road = Zone(ROAD, -road_yaw, road_yaw, *self.road_pitch_deg)
+        others = tuple(Zone(z.name, *z.yaw_deg, *z.pitch_deg) for z in self.zones)
+        return ZoneMap(
+            zones=(road, *others),
+            hysteresis_deg=self.hysteresis_deg,
+            driving_related=frozenset(self.driving_related_zones),
+        )
 
 
 class ZenohConfig(_Section):
@@ -150,6 +283,7 @@ class Config(_Section):
 
     model: ModelConfig = ModelConfig()
     geometry: GeometryConfig = GeometryConfig()
+    pose: PoseConfig = PoseConfig()
     landmarks: LandmarksConfig = LandmarksConfig()
     capture: CaptureConfig = CaptureConfig()
     smoothing: SmoothingConfig = SmoothingConfig()

@@ -189,9 +189,12 @@ class Pipeline:
         start = clock()
         detection = self.detector.detect(frame.image, frame.t_s)
         after_landmarks = clock()
-        yaw_raw_deg = self.pose.raw_yaw_deg(detection.driver)
+        driver = detection.driver
+        yaw_raw_deg = self.pose.raw_yaw_deg(driver)
+        # The matrix pitch's down gain starts at the monitor's current neutral pitch.
+        pitch_raw_deg = self.pose.raw_pitch_deg(driver, self.monitor.state.neutral_pitch_deg)
         after_geometry = clock()
-        sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg)
+        sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg, pitch_raw_deg)
         after_smoothing = clock()
         alerts = self.monitor.update(sample, self.speed())
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)

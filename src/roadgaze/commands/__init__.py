@@ -3,6 +3,7 @@
 from types import ModuleType
 
 from roadgaze.commands import (
+    batch,
     bench,
     demo,
     estimate,
@@ -23,6 +24,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     listen,
     router,
     replay,
+    batch,
     bench,
     evaluate,
     estimate,

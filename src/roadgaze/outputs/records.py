@@ -2,6 +2,8 @@
 
 `record_fields(record)` flattens a `FrameRecord` into the JSON-ready dict every writer uses:
 the pose sample's fields, then the monitor's verdict and the alerts raised on that frame.
+`RECORD_SCHEMA` types each of its fields (`alert_fields` and `ALERT_SCHEMA` do the same for one
+alert); columnar writers (the fleet's Parquet files) derive their schema from it.
 Every writer is a context manager and a pipeline sink (`on_record`, `close`).
 """
 
@@ -10,34 +12,75 @@ from __future__ import annotations
 import csv
 import json
 import math
+from enum import StrEnum
 from pathlib import Path
 from typing import IO, Any
 
 from roadgaze.errors import RoadgazeError
-from roadgaze.types import ClosesOnExit, Frame, FrameRecord
+from roadgaze.types import Alert, ClosesOnExit, Frame, FrameRecord
 
-RECORD_FIELDS = (
-    "t_s",
-    "frame",
-    "face",
-    "n_faces",
-    "yaw_raw_deg",
-    "yaw_deg",
-    "yaw_rate_dps",
-    "yaw_std_deg",
-    "x_left",
-    "x_right",
-    "x_center",
-    "roll_deg",
-    "quality",
-    "on_road",
-    "gaze",
-    "neutral_yaw_deg",
-    "off_road_s",
-    "window_off_road_s",
-    "alerts",
+
+class FieldType(StrEnum):
+    """The type of one field of a flat record; every field may also be None (null)."""
+
+    BOOL = "bool"
+    INT = "int"
+    FLOAT = "float"
+    STR = "str"
+    STR_LIST = "list[str]"
+
+
+RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
+    ("t_s", FieldType.FLOAT),
+    ("frame", FieldType.INT),
+    ("face", FieldType.BOOL),
+    ("n_faces", FieldType.INT),
+    ("yaw_raw_deg", FieldType.FLOAT),
+    ("yaw_deg", FieldType.FLOAT),
+    ("yaw_rate_dps", FieldType.FLOAT),
+    ("yaw_std_deg", FieldType.FLOAT),
+    ("pitch_raw_deg", FieldType.FLOAT),
+    ("pitch_deg", FieldType.FLOAT),
+    ("x_left", FieldType.FLOAT),
+    ("x_right", FieldType.FLOAT),
+    ("x_center", FieldType.FLOAT),
+    ("roll_deg", FieldType.FLOAT),
+    ("quality", FieldType.FLOAT),
+    ("on_road", FieldType.BOOL),
+    ("gaze", FieldType.STR),
+    ("zone", FieldType.STR),
+    ("eyes_on_road", FieldType.BOOL),
+    ("neutral_yaw_deg", FieldType.FLOAT),
+    ("neutral_pitch_deg", FieldType.FLOAT),
+    ("off_road_s", FieldType.FLOAT),
+    ("window_off_road_s", FieldType.FLOAT),
+    ("distraction_s", FieldType.FLOAT),
+    ("alerts", FieldType.STR_LIST),
+    ("yaw_offline_deg", FieldType.FLOAT),
+    ("pitch_offline_deg", FieldType.FLOAT),
 )
-"""The fields of `record_fields`, in order (x_* in pixels of the roll-removed frame)."""
+"""Every field of `record_fields`, in order, with its type: the one description the writers and
+the fleet's Parquet schema are derived from (x_* in pixels of the roll-removed frame). A field
+added to `record_fields` is added here too (a test checks it)."""
+
+RECORD_FIELDS = tuple(name for name, _ in RECORD_SCHEMA)
+"""The fields of `record_fields`, in order. `yaw_offline_deg` / `pitch_offline_deg` are null
+while a replay streams; `fill_offline_columns` fills them at its end."""
+
+OFFLINE_FIELDS = ("yaw_offline_deg", "pitch_offline_deg")
+
+ALERT_SCHEMA: tuple[tuple[str, FieldType], ...] = (
+    ("kind", FieldType.STR),
+    ("level", FieldType.STR),
+    ("t_s", FieldType.FLOAT),
+    ("yaw_deg", FieldType.FLOAT),
+    ("off_road_s", FieldType.FLOAT),
+    ("window_off_road_s", FieldType.FLOAT),
+    ("unavailable_s", FieldType.FLOAT),
+    ("speed_kmh", FieldType.FLOAT),
+    ("clears", FieldType.STR_LIST),
+)
+"""Every field of `alert_fields`: the content of an `AlertMessage` without its wire fields."""
 
 
 def rounded(value: float | None, digits: int) -> float | None:
@@ -60,17 +103,40 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "yaw_deg": rounded(sample.yaw_deg, 3),
         "yaw_rate_dps": rounded(sample.yaw_rate_dps, 3),
         "yaw_std_deg": rounded(sample.yaw_std_deg, 3),
+        "pitch_raw_deg": rounded(sample.pitch_raw_deg, 3),
+        "pitch_deg": rounded(sample.pitch_deg, 3),
         "x_left": None if features is None else rounded(features.x_left_px, 2),
         "x_right": None if features is None else rounded(features.x_right_px, 2),
         "x_center": None if features is None else rounded(features.x_center_px, 2),
-        "roll_deg": None if features is None else rounded(features.roll_deg, 2),
+        "roll_deg": rounded(sample.roll_deg, 2),
         "quality": None if features is None else rounded(features.quality, 3),
         "on_road": verdict.on_road,
         "gaze": verdict.gaze.value,
+        "zone": verdict.zone,
+        "eyes_on_road": verdict.on_road,
         "neutral_yaw_deg": round(verdict.neutral_yaw_deg, 3),
+        "neutral_pitch_deg": round(verdict.neutral_pitch_deg, 3),
         "off_road_s": round(verdict.off_road_s, 3),
         "window_off_road_s": round(verdict.window_off_road_s, 3),
+        "distraction_s": round(verdict.distraction_s, 3),
         "alerts": [alert.label for alert in record.alerts],
+        "yaw_offline_deg": None,
+        "pitch_offline_deg": None,
+    }
+
+
+def alert_fields(alert: Alert) -> dict[str, Any]:
+    """One alert as a flat JSON-ready dict with the fields of `ALERT_SCHEMA`."""
+    return {
+        "kind": alert.kind.value,
+        "level": alert.level.value,
+        "t_s": round(alert.t_s, 6),
+        "yaw_deg": rounded(alert.yaw_deg, 3),
+        "off_road_s": round(max(0.0, alert.off_road_s), 3),
+        "window_off_road_s": round(max(0.0, alert.window_off_road_s), 3),
+        "unavailable_s": round(max(0.0, alert.unavailable_s), 3),
+        "speed_kmh": rounded(alert.speed_kmh, 3),
+        "clears": [kind.value for kind in alert.clears],
     }
 
 

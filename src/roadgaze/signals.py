@@ -40,7 +40,7 @@ class StopFlag:
 @contextmanager
 def signal_handlers(stop: StopFlag, doing: str = "finishing the current frame") -> Iterator[None]:
     """SIGINT/SIGTERM/SIGHUP set `stop` (the current frame is finished); a second one exits at
-    once (exit code 1). `doing` says in the log what the first one makes the program do."""
+    once (exit code 1). `doing` says in the log what happens next."""
 
     def on_signal(number: int, frame: FrameType | None) -> None:
         name = signal.Signals(number).name

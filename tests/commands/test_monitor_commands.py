@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import json
-import logging
-from collections.abc import Iterator
 
 import jsonschema
 import pytest
@@ -12,16 +10,7 @@ import pytest
 from roadgaze.cli import main
 from roadgaze.commands.listen import _vehicle_of, format_pretty
 
-
-@pytest.fixture(autouse=True)
-def restore_logging() -> Iterator[None]:
-    """`main()` points roadgaze's log handler at the captured stderr; undo it afterwards."""
-    logger = logging.getLogger("roadgaze")
-    handlers, level, propagate = list(logger.handlers), logger.level, logger.propagate
-    yield
-    logger.handlers[:] = handlers
-    logger.setLevel(level)
-    logger.propagate = propagate
+pytestmark = pytest.mark.usefixtures("restore_logging")
 
 
 def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> None:
@@ -40,7 +29,7 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
     assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
     assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/2"
-    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/2"
+    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/3"
     snapshot = schemas["state"]["$defs"]["MonitorSnapshot"]
     assert {"zone", "neutral_pitch_deg", "pitch_deg"} <= set(snapshot["required"])
 
@@ -103,4 +92,4 @@ def test_listen_finds_the_vehicle_in_the_key() -> None:
 
 def test_bad_zenoh_option_is_a_one_line_error(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["listen", "--vehicle-id", "bad id!", "--timeout", "0.1"]) == 2
-    assert "vehicle_id" in capsys.readouterr().err
+    assert "vehicle id must be 1-64" in capsys.readouterr().err

@@ -15,6 +15,7 @@ from roadgaze.commands import (
     router,
     run,
     schema,
+    security,
     synth,
 )
 
@@ -31,6 +32,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     synth,
     model,
     schema,
+    security,
     paper,
 )
 """Each module has `register(subparsers)`, which adds its parser and sets `handler(args, config)`.

@@ -320,3 +320,41 @@ def test_router_runs_a_mutual_tls_configuration_file(certificates: Path, tmp_pat
         assert process.wait(timeout=10) == 0
     assert f"listening on tls/127.0.0.1:{port}" in started[-1]
     assert "from tls/127.0.0.1:" in opened[-1] and "as client" in opened[-1]
+
+
+def test_router_runs_the_router_file_of_security_init(tmp_path: Path) -> None:
+    """`roadgaze router --zenoh-config DIR/router/zenoh.json5`: only certified TLS sessions get
+    in, each is logged by its certificate name, the daemon's alert reaches a consumer and another
+    consumer's forged alert does not (the file's access control applies)."""
+    from roadgaze.config import ZenohConfig
+    from roadgaze.security import init_bundle
+    from roadgaze.transport import Keys
+
+    port = free_port()
+    keys = Keys.from_config(ZenohConfig(), "car-1")
+    bundle = init_bundle(tmp_path / "bundle", keys, ["fcw", "rogue"], f"tls/127.0.0.1:{port}")
+    role = {name: zenoh.Config.from_file(str(path)) for name, path in bundle.items()}
+    key = "vehicle/car-1/dms/alert"
+    with router_process("--zenoh-config", str(bundle["router"])) as (process, reader):
+        started = lines_until(reader, "listening on")
+        with pytest.raises(zenoh.ZError):  # plain TCP on the TLS port: no session
+            zenoh.open(session_config("client", [], [f"tcp/127.0.0.1:{port}"]))
+        received: list[str] = []
+        with (
+            zenoh.open(role["consumer-fcw"]) as consumer,
+            zenoh.open(role["consumer-rogue"]) as rogue,
+            zenoh.open(role["daemon"]) as daemon,
+        ):
+            consumer.declare_subscriber(key, lambda s: received.append(s.payload.to_string()))
+            publisher = daemon.declare_publisher(key)
+            assert wait_for(lambda: publisher.matching_status.matching, timeout_s=15.0)
+            rogue.put(key, "forged by another consumer")
+            publisher.put("from the daemon")
+            assert wait_for(lambda: "from the daemon" in received, timeout_s=10.0)
+            time.sleep(0.5)  # the forged put, had it passed, would have arrived by now
+            opened = lines_until(reader, "as daemon.car-1", timeout_s=10.0)
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(timeout=10) == 0
+    assert f"listening on tls/127.0.0.1:{port}" in started[-1]
+    assert received == ["from the daemon"]
+    assert any("as consumer.fcw.car-1" in line for line in opened)

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Smoke test of the deployment on one host: build localhost/roadgaze:latest, then run a Zenoh
-# router container, the daemon container on a mounted recorded video and a listener container.
-# Exits 0 only when yaw messages and an alert reached the listener and the image's health check
-# passed against the running daemon. Removes every container, network and file it made.
+# router container (`roadgaze router`), the daemon container on a mounted recorded video and a
+# listener container, on mutual TLS with access control (the files of `roadgaze security init`,
+# made in the image). Exits 0 only when yaw messages and an alert reached the listener, the
+# image's health check passed against the running daemon and the router refused a session
+# without a certificate and a forged alert. Removes every container, network and file it made.
 #
 #   sudo docker/smoke.sh                     (from anywhere in a clone; podman, else docker)
 #
@@ -20,6 +22,7 @@
 #   VIDEO=FILE               recorded drive to play (default: `roadgaze demo` makes one in the
 #                            image: a synthetic drive with glances that raise alerts)
 #   NETWORK=host|bridge      host: everything on 127.0.0.1 (default); bridge: a private network
+#   SECURE=0                 plain TCP without certificates or access control (default 1)
 #   PORT                     router port (default 7447; with NETWORK=host it must be free)
 #   RUNTIME                  podman --runtime (e.g. runc where crun fails on the host's cgroups)
 #   STORAGE_DRIVER           podman --storage-driver (e.g. vfs; podman remembers the store's driver)
@@ -32,6 +35,7 @@ IMAGE="${IMAGE:-localhost/roadgaze:latest}"
 NETWORK="${NETWORK:-host}"
 PORT="${PORT:-7447}"
 VEHICLE="smoke-$$"
+SECURE="${SECURE:-1}"
 START_TIMEOUT="${START_TIMEOUT:-180}"   # container start -> first yaw at the listener
 RUN_TIMEOUT="${RUN_TIMEOUT:-240}"       # the whole drive
 
@@ -155,19 +159,48 @@ if [[ "$NETWORK" == bridge ]]; then
 elif (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null; then
     fail "port $PORT on 127.0.0.1 is in use (PORT=... to choose another)"
 fi
-zenv=(-e ROADGAZE__ZENOH__MODE=client -e "ROADGAZE__ZENOH__CONNECT=[\"tcp/$router_host:$PORT\"]"
-      -e ROADGAZE__ZENOH__MULTICAST_SCOUTING=false -e "ROADGAZE__ZENOH__VEHICLE_ID=$VEHICLE")
 router="roadgaze-smoke-router-$$"; listener="roadgaze-smoke-listener-$$"; daemon="roadgaze-smoke-daemon-$$"
+if [[ "$SECURE" == 1 ]]; then
+    # Certificates and Zenoh files made by the image itself (owned by its user, uid 10001), the
+    # paths written as mounted below; the CA key stays in the work folder.
+    t=$(now)
+    mkdir -p "$work/zenoh"; chmod 0777 "$work/zenoh"
+    sec_endpoint="tls/127.0.0.1:$PORT"; sec_listen="$sec_endpoint"
+    [[ "$NETWORK" == bridge ]] && { sec_endpoint="tls/$router_host:$PORT"; sec_listen="tls/0.0.0.0:$PORT"; }
+    e run --rm "${run_opts[@]}" --network host --no-healthcheck -v "$work/zenoh:/out" "$IMAGE" \
+        security init /out/bundle --vehicle-id "$VEHICLE" --consumer listener --consumer health \
+        --consumer intruder --endpoint "$sec_endpoint" --listen "$sec_listen" \
+        --path-root /etc/roadgaze/zenoh > "$work/security.log" 2>&1 \
+        || { cat "$work/security.log" >&2; fail "roadgaze security init failed"; }
+    info "security init in $(since "$t") s: mutual TLS on $sec_listen, access control for $VEHICLE"
+    vol() { printf '%s\n' -v "$work/zenoh/bundle/$1:/etc/roadgaze/zenoh/$1:ro"; }
+    zfile() { printf '/etc/roadgaze/zenoh/%s/zenoh.json5' "$1"; }
+    router_args=(router --zenoh-config "$(zfile router)")
+    mapfile -t router_opts < <(vol router)
+    listener_args=(--zenoh-config "$(zfile consumer-listener)")
+    mapfile -t listener_opts < <(vol consumer-listener; vol consumer-intruder)
+    daemon_args=(--zenoh-config "$(zfile daemon)")
+    # the image's health check asks as the consumer "health"
+    mapfile -t daemon_opts < <(vol daemon; vol consumer-health)
+    daemon_opts+=(-e "ROADGAZE__ZENOH__CONFIG_FILE=$(zfile consumer-health)")
+    zenv=(-e "ROADGAZE__ZENOH__VEHICLE_ID=$VEHICLE")
+else
+    router_args=(router --listen "$listen_ep"); router_opts=(); listener_args=(); listener_opts=()
+    daemon_args=(); daemon_opts=()
+    zenv=(-e ROADGAZE__ZENOH__MODE=client -e "ROADGAZE__ZENOH__CONNECT=[\"tcp/$router_host:$PORT\"]"
+          -e ROADGAZE__ZENOH__MULTICAST_SCOUTING=false -e "ROADGAZE__ZENOH__VEHICLE_ID=$VEHICLE")
+fi
 t=$(now)
 containers+=("$router")
 e create "${run_opts[@]}" "${net_opts[@]}" --name "$router" --hostname "$router" --init --no-healthcheck \
-    "$IMAGE" router --listen "$listen_ep" >/dev/null
+    "${router_opts[@]}" "$IMAGE" "${router_args[@]}" >/dev/null
 containers+=("$listener")
 e create "${run_opts[@]}" "${net_opts[@]}" --name "$listener" --init --no-healthcheck "${zenv[@]}" \
-    "$IMAGE" listen --json --vehicle-id "$VEHICLE" --timeout "$RUN_TIMEOUT" >/dev/null
+    "${listener_opts[@]}" "$IMAGE" listen --json --vehicle-id "$VEHICLE" --timeout "$RUN_TIMEOUT" \
+    "${listener_args[@]}" >/dev/null
 containers+=("$daemon")
 e create "${run_opts[@]}" "${net_opts[@]}" --name "$daemon" --init "${zenv[@]}" -v "$work/data:/data:ro" \
-    "$IMAGE" run --source /data/drive.mp4 >/dev/null
+    "${daemon_opts[@]}" "$IMAGE" run --source /data/drive.mp4 "${daemon_args[@]}" >/dev/null
 info "created in $(since "$t") s"
 
 e start "$router" >/dev/null
@@ -215,6 +248,34 @@ done
 info "health check: $health"
 [[ "$health" == ok ]] || { cat "$work/health.out" >&2; fail "the health check did not pass while the daemon ran"; }
 
+refused="not checked (SECURE=0)"
+if [[ "$SECURE" == 1 ]]; then
+    say "access control: what the router must refuse"
+    # A session without a certificate (plain TCP on the TLS port) must not reach the daemon.
+    if e exec "$listener" roadgaze listen --query-state --timeout 5 --vehicle-id "$VEHICLE" \
+        --zenoh-mode client --zenoh-connect "tcp/$router_host:$PORT" > "$work/plain.out" 2>&1; then
+        cat "$work/plain.out" >&2; fail "a session without a certificate got the daemon's state"
+    fi
+    info "no certificate (plain TCP): refused: $(tail -n 1 "$work/plain.out" | cut -c 1-100)"
+    # A well-formed alert for this vehicle, sent with another consumer's certificate: the router's
+    # access control must drop it (only the daemon's certificate may put alerts).
+    e exec "$listener" python -c '
+import json, sys, time, zenoh
+from roadgaze.transport import AlertMessage
+vehicle, path = sys.argv[1], sys.argv[2]
+alert = AlertMessage(vehicle_id=vehicle, seq=0, kind="driver_unavailable", level="critical",
+                     t_s=4242.5, wall_time=time.time(), yaw_deg=0.0, off_road_s=0.0,
+                     window_off_road_s=0.0)
+with zenoh.open(zenoh.Config.from_file(path)) as session:
+    time.sleep(1.0)
+    session.put(f"vehicle/{vehicle}/dms/alert", alert.to_json_bytes())
+    time.sleep(1.0)
+print("forged alert sent")
+' "$VEHICLE" "$(zfile consumer-intruder)" > "$work/forge.out" 2>&1 \
+        || { cat "$work/forge.out" >&2; fail "could not send the forged alert (the check itself failed)"; }
+    refused="yes"
+fi
+
 say "waiting for the drive to end (alerts)"
 deadline=$((SECONDS + RUN_TIMEOUT))
 while [[ "$(e inspect --format '{{.State.Running}}' "$daemon")" == true ]]; do
@@ -240,7 +301,12 @@ info "yaw messages:  $yaws"
 info "alerts:        $alerts"
 info "health check:  $health"
 info "daemon exit:   $daemon_rc"
+info "refused:       $refused (a session without a certificate; a consumer's forged alert)"
 info "total:         $(since "$t_total") s"
+if [[ "$SECURE" == 1 ]] && e logs "$listener" 2>&1 | grep -q '4242\.5'; then
+    refused="NO"; info "forged alert:  reached the listener"
+    fail "the forged alert reached the listener: access control did not apply"
+fi
 (( yaws > 0 )) || fail "no yaw message reached the listener"
 (( alerts > 0 )) || fail "no alert reached the listener"
 [[ "$daemon_rc" == 0 ]] || { e logs "$daemon" | tail -n 30 >&2; fail "the daemon exited with $daemon_rc"; }

@@ -25,6 +25,7 @@ from roadgaze.transport.payloads import (
     printable,
 )
 from roadgaze.transport.publisher import BusPublisher, MessageLink
+from roadgaze.transport.router import DEFAULT_LISTEN, Router, RouterSettings, router_config
 from roadgaze.transport.session import (
     SessionPlan,
     build_zenoh_config,
@@ -39,6 +40,7 @@ from roadgaze.transport.throttle import ThrottledWarning
 
 __all__ = [
     "ALERT_SCHEMA",
+    "DEFAULT_LISTEN",
     "MESSAGE_MAX_BYTES",
     "MESSAGE_MODELS",
     "SPEED_MAX_BYTES",
@@ -54,6 +56,8 @@ __all__ = [
     "MessageLink",
     "MonitorSnapshot",
     "PayloadError",
+    "Router",
+    "RouterSettings",
     "SessionPlan",
     "SpeedInput",
     "StateMessage",
@@ -71,5 +75,6 @@ __all__ = [
     "parse_speed_kmh",
     "plan_session",
     "printable",
+    "router_config",
     "zenoh_error_text",
 ]

@@ -24,6 +24,9 @@ PURE_MODULES = (
     "roadgaze.transport.speed",
     "roadgaze.landmarks.features",
     "roadgaze.landmarks.driver",
+    "roadgaze.landmarks.eyes",
+    "roadgaze.landmarks.eye_contrast",
+    "roadgaze.eye_records",
     "roadgaze.evaluation.stats",
     "roadgaze.synth.timeline",
 )

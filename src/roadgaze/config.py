@@ -99,6 +99,33 @@ class SmoothingConfig(_Section):
     initial_rate_std_dps: float = Field(default=60.0, gt=0)
 
 
+class EyesConfig(_Section):
+    """Eye measurement: which eyes are trusted and where their direction comes from.
+
+    Defaults and their sources: docs/eyes.md.
+    """
+
+    method: Literal["blendshapes", "iris"] = "blendshapes"
+    """Eye-in-head direction from MediaPipe's eyeLook* blendshapes, or from the iris landmarks
+    with an eyeball-centre model (a diagnostic: worse on real faces)."""
+    max_head_yaw_deg: float = Field(default=60.0, gt=0, le=90)
+    """Beyond this head yaw the eyes give no direction (the yaw model saturates)."""
+    closure_max_head_yaw_deg: float = Field(default=80.0, gt=0, le=90)
+    """Up to this head yaw the nearer eye's openness is still judged."""
+    far_eye_max_yaw_deg: float = Field(default=35.0, ge=0, le=90)
+    """Beyond this head yaw only the nearer eye is used."""
+    far_eye_min_width_ratio: float = Field(default=0.6, ge=0, le=1)
+    """An eye narrower than this fraction of the other in the image is not used."""
+    min_eye_width_px: float = Field(default=8.0, ge=0)
+    min_quality: float = Field(default=0.3, ge=0, le=1)
+    """Faces of lower landmark quality (small, cut by the image edge) give no eyes."""
+    min_contrast: float = Field(default=0.15, ge=0)
+    """Eyes whose opening shows less contrast than this (relative to the skin below) while the
+    lids look open are taken as hidden (sunglasses); 0 turns the image check off."""
+    occluded_min_openness: float = Field(default=0.18, ge=0)
+    """The lids look open (so low contrast means a lens, not a closed lid) above this openness."""
+
+
 class MonitorConfig(_Section):
     """Inattention monitor thresholds (defaults and their sources: docs/monitor.md)."""
 
@@ -151,6 +178,7 @@ class Config(_Section):
     model: ModelConfig = ModelConfig()
     geometry: GeometryConfig = GeometryConfig()
     landmarks: LandmarksConfig = LandmarksConfig()
+    eyes: EyesConfig = EyesConfig()
     capture: CaptureConfig = CaptureConfig()
     smoothing: SmoothingConfig = SmoothingConfig()
     monitor: MonitorConfig = MonitorConfig()

@@ -13,14 +13,15 @@ import math
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from roadgaze.capture import FrameSource, SourceStatus
-from roadgaze.config import Config
+from roadgaze.config import Config, EyesConfig
+from roadgaze.landmarks.eyes import driver_eyes
 from roadgaze.monitor import Monitor
 from roadgaze.pose import PoseEstimator
 from roadgaze.types import Frame, FrameRecord, LandmarkDetector
@@ -165,8 +166,10 @@ class Pipeline:
         monitor: Monitor | None = None,
         speed: SpeedSource = no_speed,
         clock: Callable[[], float] = time.perf_counter,
+        eyes: EyesConfig | None = None,
     ) -> None:
         self.detector = detector
+        self.eyes = eyes if eyes is not None else EyesConfig()
         self.pose = pose if pose is not None else PoseEstimator()
         self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
         self.speed = speed
@@ -181,6 +184,7 @@ class Pipeline:
             pose=PoseEstimator.from_config(config),
             monitor=Monitor(config.monitor),
             speed=speed,
+            eyes=config.eyes,
         )
 
     def process(self, frame: Frame, decode_ms: float = 0.0) -> ProcessedFrame:
@@ -190,8 +194,11 @@ class Pipeline:
         detection = self.detector.detect(frame.image, frame.t_s)
         after_landmarks = clock()
         yaw_raw_deg = self.pose.raw_yaw_deg(detection.driver)
+        eyes = driver_eyes(detection.driver, yaw_raw_deg, self.eyes)
         after_geometry = clock()
         sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg)
+        if eyes is not None:
+            sample = replace(sample, eyes=eyes)
         after_smoothing = clock()
         alerts = self.monitor.update(sample, self.speed())
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)

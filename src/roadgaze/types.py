@@ -13,13 +13,19 @@ read the `FrameRecord`; nothing travels beside it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from enum import StrEnum
 from types import TracebackType
 from typing import Protocol, Self
 
 import numpy as np
 import numpy.typing as npt
+
+from roadgaze.eye_records import EyeMeasurement as EyeMeasurement
+from roadgaze.eye_records import EyesFeatures as EyesFeatures
+from roadgaze.eye_records import EyeStatus as EyeStatus
+from roadgaze.eye_records import EyesVerdict as EyesVerdict
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -59,6 +65,13 @@ class FaceFeatures:
     mediapipe_yaw_deg: float | None = None
     """MediaPipe's own yaw from its facial transformation matrix, project sign convention."""
     mediapipe_pitch_deg: float | None = None
+    blendshapes: Mapping[str, float] | None = None
+    """MediaPipe's 52 blendshape scores (0..1) by their ARKit names, e.g. `eyeBlinkLeft`; the
+    names give the person's own side. None when the landmarker was not asked for them."""
+    eye_contrast: tuple[float, float] | None = None
+    """Contrast inside the (right, left) eye opening relative to the skin below the eye
+    (`roadgaze.landmarks.eyes.eye_contrast`; NaN where the eye is too small to measure); None
+    when not measured. Low in both eyes while the lids look open: sunglasses or an occlusion."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,6 +111,8 @@ class PoseSample:
     yaw_std_deg: float | None
     features: FaceFeatures | None = None
     n_faces: int = 0
+    eyes: EyesFeatures | None = None
+    """The driver's eyes (roadgaze.landmarks.eyes); None without a face or eye measurement."""
 
 
 class AlertKind(StrEnum):
@@ -106,6 +121,12 @@ class AlertKind(StrEnum):
     LONG_DISTRACTION = "long_distraction"
     VATS = "vats"
     DRIVER_UNAVAILABLE = "driver_unavailable"
+    MICROSLEEP = "microsleep"
+    SLEEP = "sleep"
+    DROWSY = "drowsy"
+    UNRESPONSIVE = "unresponsive"
+    DEGRADED = "degraded"
+    """Monitoring impaired: the eyes have been unavailable too long (head pose only)."""
     CLEARED = "cleared"
 
 
@@ -142,6 +163,12 @@ class Alert:
     speed_kmh: float | None = None
     clears: tuple[AlertKind, ...] = ()
     """For `cleared`: the kinds of alert that were active."""
+    closure_s: float = 0.0
+    """Length of the current eye closure (for the closure alerts)."""
+    perclos: float | None = None
+    """Fraction of the last `perclos_window_s` with the eyes closed; None until enough is known."""
+    reason: str = ""
+    """Why the alert fired, in a few words (e.g. 'eyes closed', 'not back on road')."""
 
     @property
     def label(self) -> str:
@@ -174,6 +201,8 @@ class Verdict:
     """Alerts raised and not yet cleared, in the order they were raised."""
     alert_counts: tuple[tuple[str, int], ...] = ()
     """Alerts raised so far by `kind:level`, sorted."""
+    eyes: EyesVerdict = field(default_factory=EyesVerdict)
+    """The eyes: open, closed or unavailable, gaze, closure, PERCLOS, blinks."""
 
 
 @dataclass(frozen=True, slots=True)

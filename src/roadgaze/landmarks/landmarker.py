@@ -12,6 +12,7 @@ import os
 import sys
 import tempfile
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +21,8 @@ import numpy.typing as npt
 
 from roadgaze.config import Config, LandmarksConfig
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored
+from roadgaze.landmarks.eye_contrast import eye_contrast
+from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
 from roadgaze.landmarks.features import DEFAULT_CHOICE, LandmarkChoice, features_from_landmarks
 from roadgaze.types import ClosesOnExit, Detection, FaceFeatures
 
@@ -44,6 +47,13 @@ def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
     else:
         raise ValueError(f"expected a grayscale, BGR or BGRA image, found shape {array.shape}")
     return np.ascontiguousarray(rgb)
+
+
+def rgb_to_gray(rgb: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
+    """The grey image the eye check measures (OpenCV's luma weights)."""
+    import cv2
+
+    return np.asarray(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY), dtype=np.uint8)
 
 
 _NATIVE_NOISE = (
@@ -117,6 +127,7 @@ class MediaPipeLandmarker(ClosesOnExit):
             min_face_presence_confidence=landmarks_config.min_presence_confidence,
             min_tracking_confidence=landmarks_config.min_tracking_confidence,
             output_facial_transformation_matrixes=True,
+            output_face_blendshapes=True,
         )
         self._landmarker: Any = None
         self._mirror_landmarker: Any = None
@@ -184,15 +195,32 @@ class MediaPipeLandmarker(ClosesOnExit):
             result = landmarker.detect_for_video(mp_image, timestamp_ms)
         faces: list[FaceFeatures] = []
         matrices = result.facial_transformation_matrixes or []
+        blendshape_lists = result.face_blendshapes or []
+        gray: npt.NDArray[np.uint8] | None = None
         for index, face in enumerate(result.face_landmarks):
             points = np.array(
                 [(p.x * width, p.y * height, p.z * width) for p in face], dtype=np.float32
             )
             matrix = matrices[index] if index < len(matrices) else None
             try:
-                faces.append(features_from_landmarks(points, (width, height), matrix, self._choice))
+                features = features_from_landmarks(points, (width, height), matrix, self._choice)
             except ValueError:
                 continue
+            if gray is None:
+                gray = rgb_to_gray(rgb)
+            scores = blendshape_lists[index] if index < len(blendshape_lists) else None
+            faces.append(
+                replace(
+                    features,
+                    blendshapes=None
+                    if scores is None
+                    else {str(c.category_name): float(c.score) for c in scores},
+                    eye_contrast=(
+                        eye_contrast(gray, points, RIGHT_EYE),
+                        eye_contrast(gray, points, LEFT_EYE),
+                    ),
+                )
+            )
         return faces
 
     def close(self) -> None:

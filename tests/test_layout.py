@@ -19,6 +19,8 @@ PURE_MODULES = (
     "roadgaze.pose.smoothing",
     "roadgaze.pose",
     "roadgaze.monitor",
+    "roadgaze.monitor.eyes",
+    "roadgaze.monitor.eye_rules",
     "roadgaze.transport.messages",
     "roadgaze.transport.keys",
     "roadgaze.transport.speed",

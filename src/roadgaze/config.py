@@ -145,6 +145,38 @@ class MonitorConfig(_Section):
     """A face lost while |yaw - neutral| exceeded this counts as turned away, not unavailable;
     None: a face lost while the head was off road (past the road-ahead limit) is turned away."""
     min_speed_kmh: float = Field(default=20.0, ge=0)
+    # Eyes: closure, PERCLOS, blinks, gaze (docs/monitor.md, "Eyes").
+    eyes_close_below: float = Field(default=0.14, gt=0)
+    """Openness (lid gap / eye width) below which the eyes count as closed when the blink score
+    agrees (`eyes_blink_min`)."""
+    eyes_hard_close_below: float = Field(default=0.10, gt=0)
+    """Openness below which the eyes count as closed whatever the blink score."""
+    eyes_open_above: float = Field(default=0.18, gt=0)
+    """Closed eyes count as open again only above this openness (hysteresis)."""
+    eyes_blink_min: float = Field(default=0.4, ge=0, le=1)
+    """The eyeBlink score that must agree between `eyes_hard_close_below` and `eyes_close_below`."""
+    look_down_head_deg: float = Field(default=8.0, gt=0)
+    """Narrowed lids with the head this far below its road pitch (MediaPipe matrix pitch) read
+    as looking down, not as closed."""
+    gaze_deadband_deg: float = Field(default=10.0, ge=0)
+    """Eye-in-head deviations from the driver's resting eye direction below this count as none."""
+    eye_neutral_limit_deg: float = Field(default=15.0, ge=0)
+    microsleep_s: float = Field(default=1.0, gt=0)
+    sleep_s: float = Field(default=3.0, gt=0)
+    unresponsive_closed_s: float = Field(default=6.0, gt=0)
+    unresponsive_away_s: float = Field(default=6.0, gt=0)
+    unresponsive_after_warning_s: float = Field(default=3.0, gt=0)
+    closure_gap_s: float = Field(default=0.3, ge=0)
+    """Eyes unavailable this long inside a closure do not end it."""
+    perclos_window_s: float = Field(default=60.0, gt=0)
+    perclos_min_judged_s: float = Field(default=30.0, ge=0)
+    """PERCLOS is reported (and may raise `drowsy`) once this much of its window was judged."""
+    perclos_drowsy: float = Field(default=0.15, gt=0, le=1)
+    perclos_rearm: float = Field(default=0.10, ge=0, le=1)
+    long_blink_s: float = Field(default=0.5, gt=0)
+    long_blinks_drowsy: int = Field(default=3, ge=1)
+    degraded_after_s: float = Field(default=10.0, gt=0)
+    """Eyes unavailable this long while moving: monitoring is degraded (head pose only)."""
 
 
 class ZenohConfig(_Section):

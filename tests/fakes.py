@@ -88,10 +88,12 @@ class FakeCamera:
         self.log.append("release")
 
 
-def face_at(yaw_deg: float) -> FaceFeatures:
-    """A face whose boundaries and centre come from the paper's forward model."""
+def face_at(yaw_deg: float, pitch_deg: float | None = None) -> FaceFeatures:
+    """A face whose boundaries and centre come from the paper's forward model; `pitch_deg` is
+    MediaPipe's matrix pitch (None: no matrix)."""
     projected = forward_model(yaw_deg, half_width_px=80.0, pivot_x_px=320.0)
     return FaceFeatures(
+        mediapipe_pitch_deg=pitch_deg,
         x_left_px=float(projected.x_left),
         x_right_px=float(projected.x_right),
         x_center_px=float(projected.x_center),
@@ -103,10 +105,14 @@ def face_at(yaw_deg: float) -> FaceFeatures:
 
 
 class ScriptedDetector:
-    """Fake `LandmarkDetector`: the true yaw per call (None: no face), checking time order."""
+    """Fake `LandmarkDetector`: the true yaw per call (None: no face), checking time order;
+    optionally MediaPipe's matrix pitch per call."""
 
-    def __init__(self, yaws_deg: list[float | None]) -> None:
+    def __init__(
+        self, yaws_deg: list[float | None], pitches_deg: list[float] | None = None
+    ) -> None:
         self.yaws_deg = list(yaws_deg)
+        self.pitches_deg = pitches_deg
         self.calls: list[float | None] = []
         self.closed = False
 
@@ -116,7 +122,8 @@ class ScriptedDetector:
         self.calls.append(t_s)
         if yaw_deg is None:
             return Detection(faces=(), driver_index=None)
-        return Detection(faces=(face_at(yaw_deg),), driver_index=0)
+        pitch_deg = None if self.pitches_deg is None else self.pitches_deg[len(self.calls) - 1]
+        return Detection(faces=(face_at(yaw_deg, pitch_deg),), driver_index=0)
 
     def close(self) -> None:
         self.closed = True

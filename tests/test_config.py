@@ -13,7 +13,10 @@ from roadgaze.errors import ConfigError
 
 def test_defaults_are_the_documented_ones() -> None:
     config = load_config(environ={})
-    assert config.geometry.model == "center_ce"
+    assert config.geometry.model == "full_range"
+    assert config.geometry.full_range_cue_deg == (20.0, 90.0)
+    assert config.pose.pitch_model == "matrix"
+    assert config.pose.pitch_down_gain == 1.48
     assert config.geometry.beta == 1.25
     assert config.monitor.long_distraction_s == 3.0
     assert config.monitor.min_speed_kmh == 20.0
@@ -55,6 +58,19 @@ def test_override_values_parse_as_toml_values() -> None:
         ({"nosection.field": "1"}, "unknown section 'nosection'"),
         ({"toplevel": "1"}, "expected 'section.field'"),
         ({"zenoh.vehicle_id": "'has space'"}, "zenoh.vehicle_id"),
+        ({"pose.pitch_model": "'sphere'"}, "pose.pitch_model"),
+        ({"pose.pitch_down_gain": "0.5"}, "pose.pitch_down_gain"),
+        ({"geometry.full_range_cue_deg": "[60, 30]"}, "geometry.full_range_cue_deg"),
+        ({"smoothing.min_noise_samples": "40"}, "min_noise_samples"),
+        ({"monitor.road_pitch_deg": "[10, -10]"}, "monitor.road_pitch_deg"),
+        ({"monitor.hysteresis_deg": "25"}, "hysteresis_deg"),
+        (
+            {"monitor.zones": "[{name = 'lap', yaw_deg = [5, -5], pitch_deg = [-90, -18]}]"},
+            "yaw_deg",
+        ),
+        ({"monitor.zones": "[{name = 'Lap!', yaw_deg = [-5, 5], pitch_deg = [-90, -18]}]"}, "name"),
+        ({"monitor.zones": "[{name = 'road', yaw_deg = [-5, 5], pitch_deg = [-9, 9]}]"}, "road"),
+        ({"monitor.driving_related_zones": "['sunroof']"}, "sunroof"),
     ],
 )
 def test_bad_values_raise_config_error_naming_the_field(
@@ -79,6 +95,24 @@ def test_bad_files_raise_config_error(tmp_path: Path, content: str, message: str
 def test_missing_file_raises_config_error(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="not found"):
         load_config(tmp_path / "absent.toml", environ={})
+
+
+def test_zones_come_from_the_configuration_road_first() -> None:
+    config = load_config(
+        overrides={
+            "monitor.road_half_width_deg": "30",
+            "monitor.zones": "[{name = 'rear_mirror', yaw_deg = [-40, -15], pitch_deg = [5, 30]}]",
+            "monitor.driving_related_zones": "['rear_mirror']",
+        },
+        environ={},
+    )
+    zones = config.monitor.zone_map()
+    assert [zone.name for zone in zones.zones] == ["road", "rear_mirror"]
+    road = zones.zones[0]
+    assert (road.yaw_min_deg, road.yaw_max_deg) == (-25.0, 25.0)  # left at 30, entered at 25
+    assert (road.pitch_min_deg, road.pitch_max_deg) == (-10.0, 15.0)
+    assert zones.driving_related == frozenset({"rear_mirror"})
+    assert zones.names == ("road", "rear_mirror", "away")
 
 
 def test_bad_set_syntax_is_reported() -> None:

@@ -15,8 +15,9 @@ from roadgaze.config import Config
 from roadgaze.demo import format_alert, run_demo
 from roadgaze.synth import parse_timeline, read_truth_csv
 
-SHORT_DRIVE = "0:1,40:3.8,0:1"
-"""A 3.8 s glance: one long-distraction alert, then cleared."""
+SHORT_DRIVE = "0:1,0/-35:3.8,0:1"
+"""A 3.8 s look into the lap: one long-distraction alert, then cleared. (Before zones the glance
+went 40 deg to the left, now the left mirror, which raises no long distraction.)"""
 
 
 @pytest.mark.slow
@@ -46,8 +47,12 @@ def test_run_demo_delivers_every_alert_to_the_subscriber(tmp_path: Path) -> None
     np.testing.assert_allclose([f["t_s"] for f in frames], truth[:, 0], atol=1e-3)
     alerts = [json.loads(line) for line in (folder / "alerts.jsonl").read_text().splitlines()]
     assert alerts == list(result.alerts_received)
-    assert alerts[0]["schema"] == "roadgaze.alert/1" and alerts[0]["yaw_deg"] > 25.0
-    assert frames[-1]["gaze"] == "on_road"
+    assert alerts[0]["schema"] == "roadgaze.alert/1" and abs(alerts[0]["yaw_deg"]) < 10.0
+    assert frames[-1]["gaze"] == "on_road" and frames[-1]["zone"] == "road"
+    looking_down = [f for f in frames if 2.0 <= f["t_s"] <= 4.5]
+    assert {f["zone"] for f in looking_down} == {"lap"}
+    assert all(f["pitch_deg"] - f["neutral_pitch_deg"] < -25.0 for f in looking_down)
+    assert all(f["yaw_offline_deg"] is not None for f in frames)  # filled at the end
 
 
 def test_format_alert_is_one_readable_line() -> None:

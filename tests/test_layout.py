@@ -27,6 +27,7 @@ PURE_MODULES = (
     "roadgaze.landmarks.features",
     "roadgaze.landmarks.driver",
     "roadgaze.landmarks.eyes",
+    "roadgaze.config_eyes",
     "roadgaze.landmarks.eye_contrast",
     "roadgaze.eye_records",
     "roadgaze.evaluation.stats",

@@ -138,8 +138,8 @@ def test_from_config_uses_the_configured_model_and_constants() -> None:
 
 
 def test_the_monitor_is_a_stage_of_the_loop() -> None:
-    """A 4 s glance to 45 deg at 30 fps: the record of the frame 3 s in carries the alert."""
-    yaws: list[float | None] = [45.0 if 30 <= i < 150 else 0.0 for i in range(180)]
+    """A 4 s glance to -30 deg (zone away) at 30 fps: the record 3 s in carries the alert."""
+    yaws: list[float | None] = [-30.0 if 30 <= i < 150 else 0.0 for i in range(180)]
     config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
     pipeline = Pipeline.from_config(config, ScriptedDetector(yaws))
     records = [p.record for p in pipeline.frames(ListSource(len(yaws)))]
@@ -153,7 +153,7 @@ def test_the_monitor_is_a_stage_of_the_loop() -> None:
 
 
 def test_speed_below_the_minimum_gates_the_alerts() -> None:
-    yaws: list[float | None] = [45.0] * 150
+    yaws: list[float | None] = [-30.0] * 150
     config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0}})
     pipeline = Pipeline.from_config(config, ScriptedDetector(yaws), speed=lambda: 10.0)
     records = [p.record for p in pipeline.frames(ListSource(len(yaws)))]
@@ -176,3 +176,38 @@ def test_a_stop_ends_the_loop_before_the_next_frame() -> None:
 
     pipeline = Pipeline(ScriptedDetector([0.0] * 20))
     assert pipeline.run(ListSource(20), [StopAfter()], stop=stop).frames == 5
+
+
+def test_a_lap_glance_seen_through_the_matrix_pitch_raises_a_long_distraction() -> None:
+    """MediaPipe's matrix pitch of -25 deg reads -37 with the down gain: the lap, not the road."""
+    pitches = [-25.0 if 30 <= i < 150 else 0.0 for i in range(180)]
+    config = Config.model_validate({"monitor": {"neutral_yaw_deg": 0.0, "neutral_pitch_deg": 0.0}})
+    pipeline = Pipeline.from_config(config, ScriptedDetector([0.0] * 180, pitches))
+    records = [p.record for p in pipeline.frames(ListSource(len(pitches)))]
+    assert records[60].sample.pitch_raw_deg == pytest.approx(-25.0 * 1.48)
+    assert records[60].sample.pitch_deg == pytest.approx(-37.0, abs=0.5)
+    assert records[60].sample.roll_deg == 0.0
+    assert (records[60].verdict.zone, records[60].verdict.on_road) == ("lap", False)
+    assert (records[10].verdict.zone, records[10].verdict.on_road) == ("road", True)
+    raised = [(r.frame, a.label) for r in records for a in r.alerts]
+    off_from = next(r.frame for r in records if r.verdict.zone == "lap")
+    assert raised == [(off_from + 90, "long_distraction:warning"), (raised[1][0], "cleared:info")]
+
+
+def test_the_geometric_pitch_model_is_selectable() -> None:
+    config = Config.model_validate({"pose": {"pitch_model": "geometric"}})
+    pipeline = Pipeline.from_config(config, ScriptedDetector([0.0]))
+    face = face_at(0.0, pitch_deg=-20.0)
+    assert pipeline.pose.raw_pitch_deg(face) is None  # the fake face has no mid-line
+    from dataclasses import replace
+
+    from roadgaze.pose.pitch import midline_forward_model
+
+    line = midline_forward_model(-20.0)
+    face = replace(
+        face,
+        y_top_px=float(line.y_top),
+        y_bottom_px=float(line.y_bottom),
+        y_center_px=float(line.y_center),
+    )
+    assert pipeline.pose.raw_pitch_deg(face) == pytest.approx(-20.0)  # no down gain

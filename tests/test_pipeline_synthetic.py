@@ -73,7 +73,7 @@ def test_pipeline_yaw_follows_the_synthetic_truth(synthetic_clip: SyntheticClip)
 def test_monitor_raises_long_distraction_when_the_glance_lasts(
     synthetic_clip: SyntheticClip,
 ) -> None:
-    path, truth = synthetic_clip("0:1.5,40:4,0:1.5")
+    path, truth = synthetic_clip("0:1.5,-35:4,0:1.5")  # -35: zone away (+40: the left mirror)
     config = Config()
     monitor = run_pipeline(path, config)
     samples = monitor.samples
@@ -81,11 +81,11 @@ def test_monitor_raises_long_distraction_when_the_glance_lasts(
     assert kinds == [AlertKind.LONG_DISTRACTION, AlertKind.CLEARED]
     # Off road once the estimate leaves the 25 deg road band: truth reaches ~25 deg mid-turn.
     band = config.monitor.road_half_width_deg
-    left_road_s = next(s.t_s for s in samples if s.yaw_deg is not None and s.yaw_deg > band)
+    left_road_s = next(s.t_s for s in samples if s.yaw_deg is not None and s.yaw_deg < -band)
     long_alert = monitor.alerts[0]
     expected_s = left_road_s + config.monitor.long_distraction_s
     assert abs(long_alert.t_s - expected_s) < 0.2
-    assert 1.5 + 0.25 < left_road_s < 1.5 + 0.6  # the truth crosses 25 deg about 0.3 s in
+    assert 1.5 + 0.25 < left_road_s < 1.5 + 0.6  # the truth crosses -25 deg about 0.32 s in
     assert monitor.alerts[1].t_s > 5.5  # cleared after the head is back (turn starts at 5.5 s)
     assert len(samples) == len(truth)
 
@@ -121,6 +121,12 @@ def test_replay_on_a_synthetic_clip_writes_every_output(
     holding = np.abs(np.gradient(truth[:, 1])) < 1e-9
     assert np.max(np.abs(raw - truth[:, 1])[holding]) < 8.0
     assert len(table.read_text().splitlines()) == len(truth) + 1
+    # the offline columns, null while streaming, are filled at the normal end
+    offline = np.array([r["yaw_offline_deg"] for r in records], dtype=float)
+    assert np.all(np.isfinite(offline[raw == raw]))
+    assert np.max(np.abs(offline - truth[:, 1])[holding]) < 8.0
+    assert all(r["zone"] in ("road", "left_mirror", "away") for r in records)
+    assert "yaw_offline_deg" in table.read_text().splitlines()[0]
     assert cv2.imread(str(plot)) is not None
     capture = cv2.VideoCapture(str(video))
     assert capture.get(cv2.CAP_PROP_FRAME_COUNT) == len(truth)

@@ -15,11 +15,14 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from roadgaze.config_eyes import EyeMonitorSettings
+from roadgaze.config_eyes import EyesConfig as EyesConfig
 from roadgaze.errors import ConfigError
 
 if TYPE_CHECKING:
+    from roadgaze.monitor.zones import ZoneMap
     from roadgaze.pose.geometry import FaceModelConstants
 
 ENV_PREFIX = "ROADGAZE__"
@@ -41,20 +44,48 @@ class ModelConfig(_Section):
     download_timeout_s: float = Field(default=60.0, gt=0)
 
 
+YAW_MODEL_NAMES = ("full_range", "cylindrical", "ellipsoidal", "ce", "center_ce", "boundary_ce")
+"""Values of `geometry.model`: the service's full-range yaw, then the paper's five models."""
+
+
 class GeometryConfig(_Section):
     """The face model turning boundaries and centre into yaw (Narayanan et al. 2014)."""
 
-    model: Literal["cylindrical", "ellipsoidal", "ce", "center_ce", "boundary_ce"] = "center_ce"
+    model: Literal["full_range", "cylindrical", "ellipsoidal", "ce", "center_ce", "boundary_ce"] = (
+        "full_range"
+    )
+    """`full_range`: Center-CE blended into the cylinder where MediaPipe's own yaw says the head
+    is turned beyond Center-CE's range (docs/pose.md); any other value: that paper model alone."""
     alpha: float = Field(default=0.25, ge=0)
     beta: float = Field(default=1.25, gt=1)
     gamma_c: float = Field(default=0.1269, ge=0)
     gamma_b: float = Field(default=0.5774, ge=0)
+    full_range_cue_deg: tuple[float, float] = (20.0, 90.0)
+    """|MediaPipe matrix yaw| where the full-range blend starts and where it would reach the
+    cylinder (smoothstep between)."""
+
+    @field_validator("full_range_cue_deg")
+    @classmethod
+    def _ordered_cue(cls, value: tuple[float, float]) -> tuple[float, float]:
+        if not 0.0 <= value[0] < value[1]:
+            raise ValueError(f"needs 0 <= start < end, found {list(value)}")
+        return value
 
     def face_constants(self) -> FaceModelConstants:
         """The constants as the yaw models take them."""
         from roadgaze.pose.geometry import FaceModelConstants
 
         return FaceModelConstants(self.alpha, self.beta, self.gamma_c, self.gamma_b)
+
+
+class PoseConfig(_Section):
+    """Head pitch (docs/pose.md); the yaw model is `[geometry] model`."""
+
+    pitch_model: Literal["matrix", "geometric"] = "matrix"
+    """`matrix`: MediaPipe's facial-transformation-matrix pitch with `pitch_down_gain` below the
+    neutral (the default, better by measurement); `geometric`: the vertical CE model (P4)."""
+    pitch_down_gain: float = Field(default=1.48, ge=1.0, le=3.0)
+    """Below the neutral pose the matrix pitch's deviation is multiplied by this (1: off)."""
 
 
 class LandmarksConfig(_Section):
@@ -83,12 +114,21 @@ class CaptureConfig(_Section):
 
 
 class SmoothingConfig(_Section):
-    """Constant-velocity Kalman smoother of yaw."""
+    """The online smoother of yaw and pitch (constant-velocity Kalman) and the offline RTS pass."""
 
     measurement_std_deg: float = Field(default=3.0, gt=0)
-    """Standard deviation of one raw Center-CE measurement."""
-    acceleration_std_dps2: float = Field(default=200.0, gt=0)
-    """White-noise yaw acceleration driving the constant-velocity model."""
+    """Noise of one raw measurement until it is measured from the series, and the least noise the
+    outlier gate assumes."""
+    min_measurement_std_deg: float = Field(default=0.2, gt=0)
+    """Floor of the measured noise."""
+    noise_window: int = Field(default=31, ge=3, le=1000)
+    """Residuals (frames) the measured noise is taken over (about 2 s at 15 fps)."""
+    min_noise_samples: int = Field(default=8, ge=1)
+    """Residuals needed before the measured noise replaces `measurement_std_deg`."""
+    acceleration_std_dps2: float = Field(default=300.0, gt=0)
+    """White-noise angular acceleration driving the constant-velocity model."""
+    clamp_window_s: float = Field(default=0.5, gt=0)
+    """The estimate stays within the raw values of the last this many seconds (offline: +-half)."""
     gate_sigma: float = Field(default=4.0, gt=0)
     """Reject a measurement whose innovation exceeds this many standard deviations."""
     max_rejections: int = Field(default=3, ge=1)
@@ -98,43 +138,71 @@ class SmoothingConfig(_Section):
     initial_std_deg: float = Field(default=3.0, gt=0)
     initial_rate_std_dps: float = Field(default=60.0, gt=0)
 
-
-class EyesConfig(_Section):
-    """Eye measurement: which eyes are trusted and where their direction comes from.
-
-    Defaults and their sources: docs/eyes.md.
-    """
-
-    method: Literal["blendshapes", "iris"] = "blendshapes"
-    """Eye-in-head direction from MediaPipe's eyeLook* blendshapes, or from the iris landmarks
-    with an eyeball-centre model (a diagnostic: worse on real faces)."""
-    max_head_yaw_deg: float = Field(default=60.0, gt=0, le=90)
-    """Beyond this head yaw the eyes give no direction (the yaw model saturates)."""
-    closure_max_head_yaw_deg: float = Field(default=80.0, gt=0, le=90)
-    """Up to this head yaw the nearer eye's openness is still judged."""
-    far_eye_max_yaw_deg: float = Field(default=35.0, ge=0, le=90)
-    """Beyond this head yaw only the nearer eye is used."""
-    far_eye_min_width_ratio: float = Field(default=0.6, ge=0, le=1)
-    """An eye narrower than this fraction of the other in the image is not used."""
-    min_eye_width_px: float = Field(default=8.0, ge=0)
-    min_quality: float = Field(default=0.3, ge=0, le=1)
-    """Faces of lower landmark quality (small, cut by the image edge) give no eyes."""
-    min_contrast: float = Field(default=0.15, ge=0)
-    """Eyes whose opening shows less contrast than this (relative to the skin below) while the
-    lids look open are taken as hidden (sunglasses); 0 turns the image check off."""
-    occluded_min_openness: float = Field(default=0.18, ge=0)
-    """The lids look open (so low contrast means a lens, not a closed lid) above this openness."""
+    @model_validator(mode="after")
+    def _window_holds_enough(self) -> SmoothingConfig:
+        if self.min_noise_samples > self.noise_window:
+            raise ValueError(
+                f"min_noise_samples ({self.min_noise_samples}) must not exceed noise_window "
+                f"({self.noise_window})"
+            )
+        return self
 
 
-class MonitorConfig(_Section):
-    """Inattention monitor thresholds (defaults and their sources: docs/monitor.md)."""
+class ZoneConfig(_Section):
+    """One glance zone: a rectangle in yaw and pitch relative to the neutral pose, degrees."""
+
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]{0,31}$")
+    yaw_deg: tuple[float, float]
+    """[min, max], > 0 = the driver's own left."""
+    pitch_deg: tuple[float, float]
+    """[min, max], > 0 = up."""
+
+    @field_validator("yaw_deg", "pitch_deg")
+    @classmethod
+    def _ordered(cls, value: tuple[float, float]) -> tuple[float, float]:
+        if not value[0] <= value[1]:
+            raise ValueError(f"needs [min, max] with min <= max, found {list(value)}")
+        return value
+
+
+def _default_zones() -> list[ZoneConfig]:
+    return [
+        ZoneConfig(name="lap", yaw_deg=(-25.0, 25.0), pitch_deg=(-90.0, -18.0)),
+        ZoneConfig(name="cluster", yaw_deg=(-15.0, 15.0), pitch_deg=(-18.0, -10.0)),
+        ZoneConfig(name="centre_stack", yaw_deg=(-55.0, -15.0), pitch_deg=(-50.0, -5.0)),
+        ZoneConfig(name="left_mirror", yaw_deg=(20.0, 75.0), pitch_deg=(-25.0, 15.0)),
+        ZoneConfig(name="right_mirror", yaw_deg=(-85.0, -40.0), pitch_deg=(-25.0, 15.0)),
+    ]
+
+
+class MonitorConfig(_Section, EyeMonitorSettings):
+    """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)
+    """The road zone is left beyond this |yaw - neutral| and entered again within
+    `road_half_width_deg - hysteresis_deg`."""
     hysteresis_deg: float = Field(default=5.0, ge=0)
+    """Every zone is kept until the angles leave its rectangle grown by this."""
+    road_pitch_deg: tuple[float, float] = (-10.0, 15.0)
+    """Pitch relative to the neutral within which the road zone is entered (left beyond the
+    limits grown by `hysteresis_deg`)."""
+    zones: list[ZoneConfig] = Field(default_factory=_default_zones, max_length=32)
+    """The other zones, in priority order after the road (first match wins; nothing: away)."""
+    driving_related_zones: list[str] = Field(
+        default_factory=lambda: ["left_mirror", "right_mirror"]
+    )
+    """Zones whose time counts as off road (VATS, eyes_on_road) but does not run the
+    long-distraction timer."""
+    driving_glance_max_s: float | None = Field(default=None, gt=0)
+    """A continuous stay in a driving-related zone longer than this counts as distraction from
+    its start; None: never."""
     neutral_yaw_deg: float | None = None
     """Fixed road-ahead yaw; None learns it online from on-road samples."""
+    neutral_pitch_deg: float | None = None
+    """Fixed road-ahead pitch; None learns it online from on-road samples."""
     neutral_time_constant_s: float = Field(default=60.0, gt=0)
     neutral_limit_deg: float = Field(default=20.0, ge=0)
+    neutral_pitch_limit_deg: float = Field(default=20.0, ge=0)
     long_distraction_s: float = Field(default=3.0, gt=0)
     critical_distraction_s: float = Field(default=6.0, gt=0)
     vats_window_s: float = Field(default=30.0, gt=0)
@@ -143,40 +211,47 @@ class MonitorConfig(_Section):
     unavailable_s: float = Field(default=2.0, gt=0)
     turn_away_deg: float | None = Field(default=None, gt=0)
     """A face lost while |yaw - neutral| exceeded this counts as turned away, not unavailable;
-    None: a face lost while the head was off road (past the road-ahead limit) is turned away."""
+    None: a face lost while the head was off road (outside the road zone) is turned away."""
     min_speed_kmh: float = Field(default=20.0, ge=0)
-    # Eyes: closure, PERCLOS, blinks, gaze (docs/monitor.md, "Eyes").
-    eyes_close_below: float = Field(default=0.14, gt=0)
-    """Openness (lid gap / eye width) below which the eyes count as closed when the blink score
-    agrees (`eyes_blink_min`)."""
-    eyes_hard_close_below: float = Field(default=0.10, gt=0)
-    """Openness below which the eyes count as closed whatever the blink score."""
-    eyes_open_above: float = Field(default=0.18, gt=0)
-    """Closed eyes count as open again only above this openness (hysteresis)."""
-    eyes_blink_min: float = Field(default=0.4, ge=0, le=1)
-    """The eyeBlink score that must agree between `eyes_hard_close_below` and `eyes_close_below`."""
-    look_down_head_deg: float = Field(default=8.0, gt=0)
-    """Narrowed lids with the head this far below its road pitch (MediaPipe matrix pitch) read
-    as looking down, not as closed."""
-    gaze_deadband_deg: float = Field(default=10.0, ge=0)
-    """Eye-in-head deviations from the driver's resting eye direction below this count as none."""
-    eye_neutral_limit_deg: float = Field(default=15.0, ge=0)
-    microsleep_s: float = Field(default=1.0, gt=0)
-    sleep_s: float = Field(default=3.0, gt=0)
-    unresponsive_closed_s: float = Field(default=6.0, gt=0)
-    unresponsive_away_s: float = Field(default=6.0, gt=0)
-    unresponsive_after_warning_s: float = Field(default=3.0, gt=0)
-    closure_gap_s: float = Field(default=0.3, ge=0)
-    """Eyes unavailable this long inside a closure do not end it."""
-    perclos_window_s: float = Field(default=60.0, gt=0)
-    perclos_min_judged_s: float = Field(default=30.0, ge=0)
-    """PERCLOS is reported (and may raise `drowsy`) once this much of its window was judged."""
-    perclos_drowsy: float = Field(default=0.15, gt=0, le=1)
-    perclos_rearm: float = Field(default=0.10, ge=0, le=1)
-    long_blink_s: float = Field(default=0.5, gt=0)
-    long_blinks_drowsy: int = Field(default=3, ge=1)
-    degraded_after_s: float = Field(default=10.0, gt=0)
-    """Eyes unavailable this long while moving: monitoring is degraded (head pose only)."""
+
+    @field_validator("road_pitch_deg")
+    @classmethod
+    def _ordered_pitch(cls, value: tuple[float, float]) -> tuple[float, float]:
+        if not value[0] <= value[1]:
+            raise ValueError(f"needs [min, max] with min <= max, found {list(value)}")
+        return value
+
+    @model_validator(mode="after")
+    def _consistent_zones(self) -> MonitorConfig:
+        if self.hysteresis_deg >= self.road_half_width_deg:
+            raise ValueError(
+                f"hysteresis_deg ({self.hysteresis_deg}) must be smaller than "
+                f"road_half_width_deg ({self.road_half_width_deg})"
+            )
+        names = [zone.name for zone in self.zones]
+        reserved = sorted({"road", "away"} & set(names))
+        if reserved or len(set(names)) != len(names):
+            raise ValueError(f"zone names must be unique and not 'road' or 'away', found {names}")
+        unknown = sorted(set(self.driving_related_zones) - set(names))
+        if unknown:
+            raise ValueError(
+                f"driving_related_zones names zones that are not configured: {unknown} "
+                f"(zones: {names})"
+            )
+        return self
+
+    def zone_map(self) -> ZoneMap:
+        """The zones as the monitor classifies with them, the road first."""
+        from roadgaze.monitor.zones import ROAD, Zone, ZoneMap
+
+        road_yaw = self.road_half_width_deg - self.hysteresis_deg
+        road = Zone(ROAD, -road_yaw, road_yaw, *self.road_pitch_deg)
+        others = tuple(Zone(z.name, *z.yaw_deg, *z.pitch_deg) for z in self.zones)
+        return ZoneMap(
+            zones=(road, *others),
+            hysteresis_deg=self.hysteresis_deg,
+            driving_related=frozenset(self.driving_related_zones),
+        )
 
 
 class ZenohConfig(_Section):
@@ -209,6 +284,7 @@ class Config(_Section):
 
     model: ModelConfig = ModelConfig()
     geometry: GeometryConfig = GeometryConfig()
+    pose: PoseConfig = PoseConfig()
     landmarks: LandmarksConfig = LandmarksConfig()
     eyes: EyesConfig = EyesConfig()
     capture: CaptureConfig = CaptureConfig()

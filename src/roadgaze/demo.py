@@ -1,9 +1,10 @@
 """`roadgaze demo`: a synthetic drive through the whole service, with a Zenoh subscriber watching.
 
 One run, no camera and no video needed: the astronaut photo (or `photo`) is turned through a short
-drive (road, one long glance away, a few short ones, road again) by `roadgaze.synth`; the service
-(`roadgaze.pipeline` + `roadgaze.daemon.bus_outputs`: landmarks, Center-CE, Kalman smoother,
-monitor, Zenoh publisher on 127.0.0.1) runs over the clip as fast as it can; a second Zenoh session,
+drive (road, one long look into the lap, a few short glances, road again) by `roadgaze.synth`;
+the service (`roadgaze.pipeline` + `roadgaze.daemon.bus_outputs`: landmarks, full-range yaw,
+pitch, smoother, monitor with zones, Zenoh publisher on 127.0.0.1) runs over the clip as fast as
+it can; a second Zenoh session,
 connected to the first over loopback, subscribes to the alert key and reports each alert as it
 arrives. The output folder then holds the clip and its truth, the per-frame records, the received
 alerts, a plot and the annotated video.
@@ -31,9 +32,11 @@ from roadgaze.synth import Timeline, parse_timeline, truth_path_for, write_truth
 
 log = logging.getLogger(__name__)
 
-DRIVE_TIMELINE = "0:3,40:5,0:2,-35:1.5,0:1.5,35:1.5,0:1.5,-40:1.5,0:1.5,30:1.5,0:3"
-"""Road 3 s; a 5 s glance to the left (a long-distraction alert); four 1.5 s glances that push the
-off-road time in the last 30 s over 10 s (a VATS alert); back to the road (cleared)."""
+DRIVE_TIMELINE = "0:3,0/-35:5,0:2,-35:1.5,0:1.5,35:1.5,0:1.5,-45:1.5,0:1.5,30:1.5,0:3"
+"""Road 3 s; a 5 s look down into the lap (a long-distraction alert); four 1.5 s glances (to the
+right, the left mirror, the right mirror, the left mirror) that push the off-road time in the
+last 30 s over 10 s (a VATS alert: mirror glances count); back to the road (cleared).
+(Before zones the long glance went 40 deg to the left, which is now the left mirror.)"""
 DEMO_FPS = 15.0
 DEMO_SIZE = (640, 480)
 SUBSCRIBER_WAIT_S = 10.0
@@ -200,7 +203,7 @@ def run_demo(
     """
     from roadgaze.capture import open_source
     from roadgaze.daemon import bus_outputs
-    from roadgaze.outputs import AnnotatedVideoWriter, JsonlWriter, YawPlot
+    from roadgaze.outputs import AnnotatedVideoWriter, JsonlWriter, YawPlot, fill_offline_columns
     from roadgaze.pipeline import Pipeline, create_detector
     from roadgaze.synth import FaceRenderer, load_photo, render_clip
 
@@ -254,6 +257,7 @@ def run_demo(
         if not subscriber.wait_for_count(raised, SUBSCRIBER_WAIT_S):
             log.warning("the subscriber received %d of %d alerts", len(subscriber.received), raised)
         received = tuple(subscriber.received)
+    fill_offline_columns(out_dir / FRAMES_NAME, config.smoothing)
     served = time.perf_counter()
 
     smoothed = np.asarray(plot.smoothed_deg)

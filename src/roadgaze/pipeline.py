@@ -193,10 +193,13 @@ class Pipeline:
         start = clock()
         detection = self.detector.detect(frame.image, frame.t_s)
         after_landmarks = clock()
-        yaw_raw_deg = self.pose.raw_yaw_deg(detection.driver)
-        eyes = driver_eyes(detection.driver, yaw_raw_deg, self.eyes)
+        driver = detection.driver
+        yaw_raw_deg = self.pose.raw_yaw_deg(driver)
+        # The matrix pitch's down gain starts at the monitor's current neutral pitch.
+        pitch_raw_deg = self.pose.raw_pitch_deg(driver, self.monitor.state.neutral_pitch_deg)
+        eyes = driver_eyes(driver, yaw_raw_deg, self.eyes)
         after_geometry = clock()
-        sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg)
+        sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg, pitch_raw_deg)
         if eyes is not None:
             sample = replace(sample, eyes=eyes)
         after_smoothing = clock()

@@ -6,9 +6,10 @@ frames. Image x grows to the right, y downwards. Yaw > 0: head turned to the dri
 (ISO 8855), which an unmirrored camera sees as the nose pointing to the image right.
 
 A frame travels as: `Frame` (capture) -> `Detection` of `FaceFeatures` (landmarks) ->
-`PoseSample` (pose: the yaw model and the smoother) -> `FrameRecord` (the monitor adds its
-`Verdict` and the `Alert`s raised on that frame). Writers, the annotator and the Zenoh publisher
-read the `FrameRecord`; nothing travels beside it.
+`PoseSample` (pose: yaw, pitch, roll and the smoother) -> `FrameRecord` (the monitor adds its
+`Verdict`, with the glance zone, and the `Alert`s raised on that frame). Writers, the annotator
+and the Zenoh publisher read the `FrameRecord`; nothing travels beside it. Pitch > 0 = looking
+up (the elevation of the face's forward direction).
 """
 
 from __future__ import annotations
@@ -65,6 +66,13 @@ class FaceFeatures:
     mediapipe_yaw_deg: float | None = None
     """MediaPipe's own yaw from its facial transformation matrix, project sign convention."""
     mediapipe_pitch_deg: float | None = None
+    """MediaPipe's own pitch from the same matrix, > 0 = up."""
+    y_top_px: float | None = None
+    """Roll-removed y of the top of the face's mid-line (forehead, landmark 10), pixels, y down."""
+    y_bottom_px: float | None = None
+    """Roll-removed y of the bottom of the mid-line (chin, landmark 152)."""
+    y_center_px: float | None = None
+    """Roll-removed y of the mid-line's centre (nose tip, landmark 1): the pitch model's input."""
     blendshapes: Mapping[str, float] | None = None
     """MediaPipe's 52 blendshape scores (0..1) by their ARKit names, e.g. `eyeBlinkLeft`; the
     names give the person's own side. None when the landmarker was not asked for them."""
@@ -88,12 +96,12 @@ class Detection:
 
 
 @dataclass(frozen=True, slots=True)
-class SmoothedYaw:
-    """State of the yaw smoother after one update or prediction."""
+class SmoothedAngle:
+    """The online smoother's estimate of one angle (yaw or pitch) after an update."""
 
-    yaw_deg: float
-    yaw_rate_dps: float
-    yaw_std_deg: float
+    angle_deg: float
+    rate_dps: float
+    std_deg: float
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,6 +119,12 @@ class PoseSample:
     yaw_std_deg: float | None
     features: FaceFeatures | None = None
     n_faces: int = 0
+    pitch_raw_deg: float | None = None
+    """Pitch model output of this frame (> 0 = up); None without a face or a usable pitch."""
+    pitch_deg: float | None = None
+    """Smoothed pitch; None before the first pitch or after the track was dropped."""
+    roll_deg: float | None = None
+    """Eye-line roll of this frame (> 0 = counter-clockwise in the image); None without a face."""
     eyes: EyesFeatures | None = None
     """The driver's eyes (roadgaze.landmarks.eyes); None without a face or eye measurement."""
 
@@ -201,6 +215,16 @@ class Verdict:
     """Alerts raised and not yet cleared, in the order they were raised."""
     alert_counts: tuple[tuple[str, int], ...] = ()
     """Alerts raised so far by `kind:level`, sorted."""
+    zone: str | None = "road"
+    """Glance zone (docs/monitor.md): `road`, a configured zone or `away`; None when the gaze is
+    unknown. `on_road` is `zone == "road"`."""
+    pitch_deg: float | None = None
+    """The pitch judged (smoothed, else raw); None without a face or a usable pitch."""
+    neutral_pitch_deg: float = 0.0
+    """The road-ahead pitch the monitor measures against (fixed or learned)."""
+    distraction_s: float = 0.0
+    """Time of the current off-road episode spent outside driving-related zones: the
+    long-distraction timer."""
     eyes: EyesVerdict = field(default_factory=EyesVerdict)
     """The eyes: open, closed or unavailable, gaze, closure, PERCLOS, blinks."""
 

@@ -36,6 +36,13 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     yaw_fields = {"schema", "vehicle_id", "seq", "t_s", "frame", "face", "yaw_deg", "yaw_raw_deg"}
     assert yaw_fields | {"on_road"} <= set(schemas["yaw"]["properties"])
     assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/1"
+    # roadgaze.yaw/2 extends /1 with the pose and the zone; every field is always published
+    new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
+    assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
+    assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/2"
+    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/2"
+    snapshot = schemas["state"]["$defs"]["MonitorSnapshot"]
+    assert {"zone", "neutral_pitch_deg", "pitch_deg"} <= set(snapshot["required"])
 
 
 def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
@@ -64,6 +71,23 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
             "yaw",
             {"seq": 9, "t_s": 0.3, "yaw_deg": -12.34, "gaze": "on_road"},
             "yaw    car-1 #9 t=0.30s   -12.3° on_road",
+        ),
+        (
+            "yaw",
+            {"seq": 9, "t_s": 0.3, "yaw_deg": 1.0, "pitch_deg": -41.26, "zone": "lap"},
+            "yaw    car-1 #9 t=0.30s    +1.0° pitch   -41.3° lap",
+        ),
+        (
+            "yaw",
+            {
+                "seq": 9,
+                "t_s": 0.3,
+                "yaw_deg": None,
+                "pitch_deg": None,
+                "zone": None,
+                "gaze": "unknown",
+            },
+            "yaw    car-1 #9 t=0.30s     --   pitch     --   unknown",
         ),
         ("state", None, "state  car-1 undecodable payload: garbage"),
     ],

@@ -7,6 +7,7 @@ import csv
 import json
 import math
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import cv2
@@ -153,6 +154,40 @@ def test_evaluate_ranges_and_bins() -> None:
     text = format_report(report)
     for label in ("Cylindrical", "Center-CE", "Boundary-CE", "MediaPipe matrix", "|yaw| <= 60"):
         assert label in text
+    assert "Service yaw" in text
+    assert report.pitch is None  # no pitch labels: no pitch report
+    assert inner["service"].mae_deg == pytest.approx(3.0)  # falls back to Center-CE here
+
+
+def test_pitch_report_rank_correlation_bias_and_lap() -> None:
+    from roadgaze.evaluation import evaluate_pitch, format_pitch_report
+
+    tilts = [-60.0, -60.0, -30.0, 0.0, 0.0, 15.0, 30.0]
+    readings = [-40.0, -20.0, -25.0, 1.0, -2.0, 8.0, 15.0]  # one lap still reads shallow
+    zones = ["lap", "road", "lap", "road", "road", "road", "road"]
+    truths = [GroundTruth(f"f{i}", 0.0, tilt) for i, tilt in enumerate(tilts)]
+    estimates = [
+        replace(
+            _estimate(f"f{i}", 0.0), pitch_deg=pitch, mediapipe_pitch_deg=pitch / 1.48, zone=zone
+        )
+        for i, (pitch, zone) in enumerate(zip(readings, zones, strict=True))
+    ]
+    report = evaluate_pitch(truths, estimates)
+    assert report is not None
+    service = report.methods["service"]
+    # ranks of the readings: -40 1, -25 2, -20 3, -2 4, 1 5, 8 6, 15 7; tilts tie at -60 and 0
+    assert service.spearman == pytest.approx(25.5 / math.sqrt(27 * 28))
+    assert service.lap_auc == 1.0  # both lap stills read below every level one
+    by_tilt = {t.tilt_deg: t for t in service.tilts}
+    assert by_tilt[-60.0].mean_deg == pytest.approx(-30.0)
+    assert by_tilt[-60.0].bias_deg == pytest.approx(30.0)
+    assert by_tilt[0.0].mae_deg == pytest.approx(0.5 * (1.0 + 2.0))
+    assert report.methods["matrix"].spearman == pytest.approx(service.spearman)
+    lap = report.lap[0]
+    assert (lap.n_lap, lap.lap_as_lap, lap.lap_as_down) == (2, 1, 1)
+    assert (lap.n_level, lap.level_as_lap, lap.level_as_road) == (3, 0, 3)
+    text = format_pitch_report(report)
+    assert "Service pitch" in text and "lap vs level" in text and " 50.0%" in text
 
 
 def test_outputs_predictions_report_plot(tmp_path: Path) -> None:
@@ -161,8 +196,10 @@ def test_outputs_predictions_report_plot(tmp_path: Path) -> None:
     with (tmp_path / "p.csv").open() as stream:
         rows = list(csv.reader(stream))
     assert tuple(rows[0]) == PREDICTION_COLUMNS
-    assert rows[1] == ["a", "1", "2.000", "3.000", "4.000", "5.000", "6.000", "0.000"]
-    assert rows[3] == ["c", "0", "", "", "", "", "", ""]
+    # the service's yaw falls back to Center-CE where it was not computed
+    yaws = ["2.000", "3.000", "4.000", "5.000", "6.000", "0.000", "5.000"]
+    assert rows[1] == ["a", "1", *yaws, "", "0.000", "", "", ""]
+    assert rows[3] == ["c", "0", *[""] * (len(PREDICTION_COLUMNS) - 2)]
     write_report(tmp_path / "r.json", report)
     loaded = json.loads((tmp_path / "r.json").read_text())
     assert set(loaded["ranges"]["all"]) == set(METHODS)

@@ -30,7 +30,9 @@ YawAt = Callable[[float], float | None]
 """Yaw at time t, None for no face."""
 
 
-def sample(t_s: float, yaw_deg: float | None, frame: int = 0) -> PoseSample:
+def sample(
+    t_s: float, yaw_deg: float | None, frame: int = 0, pitch_deg: float | None = None
+) -> PoseSample:
     face = yaw_deg is not None
     return PoseSample(
         t_s=t_s,
@@ -41,6 +43,8 @@ def sample(t_s: float, yaw_deg: float | None, frame: int = 0) -> PoseSample:
         yaw_rate_dps=0.0 if face else None,
         yaw_std_deg=1.0 if face else None,
         n_faces=int(face),
+        pitch_raw_deg=pitch_deg if face else None,
+        pitch_deg=pitch_deg if face else None,
     )
 
 
@@ -58,8 +62,13 @@ def run(
     return monitor, alerts
 
 
+AWAY_YAW_DEG = -30.0
+"""A glance to the driver's right, short of the right mirror: zone `away` (not driving-related).
+(Before zones the timing tests glanced to +45 deg, which the default zones call `left_mirror`.)"""
+
+
 def glances(
-    starts_s: list[float], length_s: float, yaw_deg: float = 45.0, base_deg: float = 0.0
+    starts_s: list[float], length_s: float, yaw_deg: float = AWAY_YAW_DEG, base_deg: float = 0.0
 ) -> YawAt:
     def yaw_at(t_s: float) -> float:
         inside = any(start <= t_s + 1e-9 < start + length_s for start in starts_s)
@@ -81,7 +90,7 @@ def test_long_distraction_fires_three_seconds_into_a_glance_then_clears() -> Non
     assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
     assert_within_one_frame(alerts[0].t_s, 7.0)
     assert alerts[0].off_road_s == pytest.approx(3.0, abs=FRAME_S)
-    assert alerts[0].yaw_deg == 45.0
+    assert alerts[0].yaw_deg == AWAY_YAW_DEG
     assert_within_one_frame(alerts[1].t_s, 8.0)
     assert alerts[1].clears == (AlertKind.LONG_DISTRACTION,)
     assert alerts[1].off_road_s == pytest.approx(4.0, abs=FRAME_S)
@@ -129,7 +138,7 @@ def test_yaw_flickering_around_the_limit_does_not_restart_the_episode() -> None:
     def yaw_at(t_s: float) -> float:
         if t_s < 1.0:
             return 0.0
-        return 26.0 if int(t_s * FPS) % 2 else 23.0  # inside the hysteresis band once off road
+        return -26.0 if int(t_s * FPS) % 2 else -23.0  # inside the hysteresis band once off road
 
     _, alerts = run(yaw_at, 4.5)
     assert kinds(alerts) == [("long_distraction", "warning")]
@@ -220,7 +229,8 @@ def test_face_lost_after_a_turn_is_off_road_not_unavailable() -> None:
             return None  # profile: the landmarker loses the face
         return 0.0
 
-    monitor, alerts = run(yaw_at, 8.0)
+    no_mirrors = FIXED.model_copy(update={"driving_related_zones": []})  # the turn crosses one
+    monitor, alerts = run(yaw_at, 8.0, no_mirrors)
     assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
     first_off = next(k / FPS for k in range(300) if (yaw_at(k / FPS) or 0.0) > 25.0)
     assert_within_one_frame(alerts[0].t_s, first_off + 3.0)
@@ -261,18 +271,30 @@ def test_explicit_turn_away_angle() -> None:
     assert_within_one_frame(alerts[0].t_s, 3.5)
 
 
-def test_neutral_is_learned_slowly_from_on_road_samples() -> None:
+def test_neutral_settles_on_the_road_pose_then_follows_it_slowly() -> None:
+    """A running mean at first (the road pose within a second), then the 60 s filter.
+
+    (Before pitch, the neutral followed the 60 s filter from the start: 15.6 deg after 120 s at
+    18 deg; a neutral that takes minutes to settle put the matrix pitch's down gain and the
+    lap limit at the camera's axis instead of the driver's road pose for the whole first minute.)
+    """
     config = MonitorConfig()  # learning on, time constant 60 s
-    monitor, alerts = run(lambda t: 18.0, 120.0, config)
+    monitor, alerts = run(lambda t: 18.0, 1.0, config)
     assert alerts == []
-    # After two time constants the neutral has moved 1 - e^-2 of the way.
-    assert monitor.state.neutral_yaw_deg == pytest.approx(18.0 * (1 - 2.718281828**-2), abs=0.05)
-    monitor.update(sample(120.0, 18.0 + 24.0))  # 24 deg from neutral would be off road at 0
-    assert monitor.state.on_road is False  # 42 - 15.6 = 26.4 > 25
-    monitor.update(sample(121.0, 37.0))
-    assert monitor.state.on_road is False  # 37 - 15.6 = 21.4: inside the hysteresis band
-    monitor.update(sample(122.0, 35.0))
-    assert monitor.state.on_road is True  # 35 - 15.6 = 19.4 <= 20
+    assert monitor.state.neutral_yaw_deg == pytest.approx(18.0)
+    for frame in range(30, round(120 * FPS)):
+        monitor.update(sample(frame / FPS, 18.0))
+    for frame in range(round(120 * FPS), round(180 * FPS)):
+        monitor.update(sample(frame / FPS, 8.0))  # the road pose moves by 10 deg
+    # 120 s learned: the running mean's gain is below the filter's, which moves 1 - e^-1 in 60 s.
+    assert monitor.state.neutral_yaw_deg == pytest.approx(8.0 + 10.0 * 2.718281828**-1, abs=0.1)
+    neutral = monitor.state.neutral_yaw_deg
+    monitor.update(sample(180.0, neutral + 26.0))  # 26 deg from the neutral: off road
+    assert monitor.state.on_road is False
+    monitor.update(sample(181.0, neutral + 21.4))
+    assert monitor.state.on_road is False  # inside the hysteresis band
+    monitor.update(sample(182.0, neutral + 19.4))
+    assert monitor.state.on_road is True  # back within 20
 
 
 def test_neutral_is_clamped_and_fixed_neutral_is_used_as_is() -> None:
@@ -318,3 +340,154 @@ def test_monitor_imports_no_heavy_modules() -> None:
         [sys.executable, "-c", code], capture_output=True, timeout=60, env=env, check=False
     )
     assert result.returncode == 0, result.stderr
+
+
+# Zones: mirrors are driving-related (off road, counted for VATS, no long distraction alone).
+
+Pose = tuple[float, float] | None
+"""(yaw, pitch) at a time; None for no face."""
+
+
+def run_poses(
+    pose_at: Callable[[float], Pose], duration_s: float, config: MonitorConfig = FIXED
+) -> tuple[Monitor, list[Alert], list[str | None]]:
+    monitor = Monitor(config)
+    alerts: list[Alert] = []
+    zones: list[str | None] = []
+    for frame in range(round(duration_s * FPS)):
+        t_s = frame / FPS
+        pose = pose_at(t_s)
+        yaw, pitch = (None, None) if pose is None else pose
+        alerts.extend(monitor.update(sample(t_s, yaw, frame, pitch)))
+        zones.append(monitor.verdict.zone)
+    return monitor, alerts, zones
+
+
+def segments(*parts: tuple[float, Pose]) -> Callable[[float], Pose]:
+    """Consecutive (seconds, pose) parts; the last pose holds afterwards."""
+
+    def pose_at(t_s: float) -> Pose:
+        start = 0.0
+        for length_s, pose in parts:
+            if t_s + 1e-9 < start + length_s:
+                return pose
+            start += length_s
+        return parts[-1][1]
+
+    return pose_at
+
+
+ROAD_POSE = (0.0, 0.0)
+LEFT_MIRROR = (45.0, 0.0)
+RIGHT_MIRROR = (-60.0, 0.0)
+AWAY_POSE = (AWAY_YAW_DEG, 0.0)
+LAP = (0.0, -35.0)
+
+
+def test_a_long_mirror_glance_is_off_road_but_raises_no_long_distraction() -> None:
+    _, alerts, zones = run_poses(
+        segments((1.0, ROAD_POSE), (8.0, LEFT_MIRROR), (2.0, ROAD_POSE)), 11.0
+    )
+    assert alerts == []
+    assert zones[60] == "left_mirror" and zones[-1] == "road"
+    inside = Monitor(FIXED)
+    for frame in range(round(5.0 * FPS)):
+        inside.update(sample(frame / FPS, 0.0 if frame < 30 else 45.0, frame, 0.0))
+    verdict = inside.verdict
+    assert (verdict.zone, verdict.on_road, verdict.gaze) == ("left_mirror", False, Gaze.OFF_ROAD)
+    assert verdict.off_road_s == pytest.approx(4.0 - FRAME_S, abs=1e-6)
+    assert verdict.window_off_road_s == pytest.approx(4.0 - FRAME_S, abs=1e-6)
+    assert verdict.distraction_s == 0.0
+
+
+def test_mirror_glances_count_for_vats() -> None:
+    parts: list[tuple[float, Pose]] = [(1.0, ROAD_POSE)]
+    for mirror in (LEFT_MIRROR, RIGHT_MIRROR) * 3:
+        parts += [(2.5, mirror), (1.0, ROAD_POSE)]
+    _, alerts, _ = run_poses(segments(*parts), 22.0)
+    assert kinds(alerts) == [("vats", "warning"), ("cleared", "info")]
+    assert_within_one_frame(alerts[0].t_s, 1.0 + 3 * 3.5 + 2.5)  # the fourth glance ends at 10 s
+
+
+@pytest.mark.parametrize(
+    ("parts", "expected_s"),
+    [
+        # mirror 1 s, then away: the timer starts with the away part and fires 3 s into it
+        (((1.0, ROAD_POSE), (1.0, LEFT_MIRROR), (5.0, AWAY_POSE)), 1.0 + 1.0 + 3.0),
+        # away 2 s, mirror 2 s (pauses, does not reset), away again: 1 s more
+        (((1.0, ROAD_POSE), (2.0, AWAY_POSE), (2.0, RIGHT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 5.0),
+        # mirror 1.5 s then away 2 s: 2 s of distraction, no alert
+        (((1.0, ROAD_POSE), (1.5, LEFT_MIRROR), (2.0, AWAY_POSE), (2.0, ROAD_POSE)), None),
+        # the lap is not driving-related
+        (((1.0, ROAD_POSE), (4.0, LAP), (1.0, ROAD_POSE)), 1.0 + 3.0),
+    ],
+)
+def test_mirror_time_pauses_the_long_distraction_timer(
+    parts: tuple[tuple[float, Pose], ...], expected_s: float | None
+) -> None:
+    total_s = sum(length for length, _ in parts) + 1.0
+    _, alerts, _ = run_poses(segments(*parts), total_s)
+    long_alerts = [a for a in alerts if a.label == "long_distraction:warning"]
+    if expected_s is None:
+        assert long_alerts == []
+    else:
+        assert len(long_alerts) == 1
+        assert_within_one_frame(long_alerts[0].t_s, expected_s)
+        assert long_alerts[0].off_road_s == pytest.approx(expected_s - 1.0, abs=FRAME_S)
+
+
+def test_a_mirror_stay_longer_than_the_limit_counts_from_its_start() -> None:
+    config = FIXED.model_copy(update={"driving_glance_max_s": 2.0})
+    _, alerts, _ = run_poses(
+        segments((1.0, ROAD_POSE), (5.0, LEFT_MIRROR), (1.0, ROAD_POSE)), 7.0, config
+    )
+    assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
+    assert_within_one_frame(alerts[0].t_s, 1.0 + 3.0)
+    _, short, _ = run_poses(
+        segments((1.0, ROAD_POSE), (1.9, LEFT_MIRROR), (2.0, AWAY_POSE), (1.0, ROAD_POSE)),
+        6.0,
+        config,
+    )
+    assert short == []  # 1.9 s of mirror is a glance; 2 s away is not yet a long distraction
+
+
+def test_a_face_lost_in_a_mirror_glance_counts_as_away() -> None:
+    _, alerts, zones = run_poses(
+        segments((1.0, ROAD_POSE), (1.0, LEFT_MIRROR), (4.0, None), (1.0, ROAD_POSE)), 7.0
+    )
+    assert zones[45] == "left_mirror" and zones[75] == "away"
+    assert kinds(alerts) == [("long_distraction", "warning"), ("cleared", "info")]
+    assert_within_one_frame(alerts[0].t_s, 2.0 + 3.0)  # from the loss: out of view is not a mirror
+
+
+def test_pitch_neutral_is_learned_and_looking_down_is_the_lap() -> None:
+    config = MonitorConfig(neutral_yaw_deg=0.0)  # pitch neutral learned
+    camera_low = 12.0  # the road-ahead pose seen from a camera below the line of sight
+    monitor, alerts, zones = run_poses(lambda t: (0.0, camera_low), 3.0, config)
+    assert alerts == [] and set(zones) == {"road"}
+    assert monitor.state.neutral_pitch_deg == pytest.approx(camera_low)
+    neutral = monitor.state.neutral_pitch_deg
+    monitor.update(sample(3.0, 0.0, 0, neutral - 19.0))
+    assert monitor.verdict.zone == "lap"  # 19 deg below the neutral, 7 deg below the camera axis
+    fixed = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=-5.0)
+    monitor, _, zones = run_poses(lambda t: (0.0, -25.0), 2.0, fixed)
+    assert monitor.state.neutral_pitch_deg == -5.0 and zones[-1] == "lap"
+
+
+def test_a_sample_without_pitch_is_judged_at_level_pitch() -> None:
+    _, _, zones = run_poses(lambda t: None if t < 0 else (0.0, float("nan")), 1.0)
+    assert zones[-1] == "road"
+
+
+def test_a_road_pose_outside_the_road_zone_at_first_is_still_learned() -> None:
+    """A camera 16 deg above the line of sight: the road pose reads pitch -16 (below the road
+    zone while the neutral is 0); it is learned within a second and never raises an alert."""
+    config = MonitorConfig(neutral_yaw_deg=0.0)
+    monitor, alerts, zones = run_poses(lambda t: (0.0, -16.0), 10.0, config)
+    assert alerts == []
+    assert zones[0] == "cluster" and zones[-1] == "road"
+    assert zones.index("road") <= FPS  # within a second
+    assert monitor.state.neutral_pitch_deg == pytest.approx(-16.0)
+    lap_glance, _, _ = run_poses(lambda t: (0.0, -16.0 if t < 2.0 else -45.0), 6.0, config)
+    assert lap_glance.state.neutral_pitch_deg == pytest.approx(-16.0)  # a lap glance does not teach
+    assert lap_glance.verdict.zone == "lap"

@@ -1,4 +1,5 @@
-"""YawSmoother on synthetic tracks with known truth (noise, step, gaps, outliers)."""
+"""The online angle smoother on synthetic tracks with known truth (noise, steps, gaps, outliers,
+the raw-range bound)."""
 
 from __future__ import annotations
 
@@ -6,7 +7,8 @@ import numpy as np
 import pytest
 
 from roadgaze.config import SmoothingConfig
-from roadgaze.pose.smoothing import YawSmoother
+from roadgaze.pose.offline import excursion_deg
+from roadgaze.pose.smoothing import AngleSmoother, extrapolation_residuals, robust_noise_std_deg
 
 FPS = 30.0
 
@@ -17,10 +19,10 @@ def smooth(
     seed: int = 0,
     config: SmoothingConfig | None = None,
     missing: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, YawSmoother]:
+) -> tuple[np.ndarray, np.ndarray, AngleSmoother]:
     """Smoothed yaw and std per frame (NaN where there is no track)."""
     rng = np.random.default_rng(seed)
-    smoother = YawSmoother(config or SmoothingConfig())
+    smoother = AngleSmoother(config or SmoothingConfig())
     yaw, std = np.full(len(truth_deg), np.nan), np.full(len(truth_deg), np.nan)
     for i, value in enumerate(truth_deg):
         measured = None if missing is not None and missing[i] else value
@@ -28,7 +30,7 @@ def smooth(
             measured += noise_std_deg * rng.standard_normal()
         result = smoother.update(i / FPS, measured)
         if result is not None:
-            yaw[i], std[i] = result.yaw_deg, result.yaw_std_deg
+            yaw[i], std[i] = result.angle_deg, result.std_deg
     return yaw, std, smoother
 
 
@@ -100,55 +102,145 @@ def test_long_gap_drops_the_track_and_restarts_on_the_next_face() -> None:
 
 def test_single_outlier_is_gated_out() -> None:
     truth = np.full(60, 5.0)
-    smoother = YawSmoother()
+    smoother = AngleSmoother()
     results = []
     for i, value in enumerate(truth):
         measured = 60.0 if i == 40 else float(value)
         result = smoother.update(i / FPS, measured)
         assert result is not None
-        results.append(result.yaw_deg)
+        results.append(result.angle_deg)
     assert abs(results[40] - 5.0) < 0.5
     assert smoother.state.rejected_total == 1
     assert smoother.state.reinitialisations == 0
 
 
 def test_no_face_before_first_face_gives_none_and_nan_counts_as_no_face() -> None:
-    smoother = YawSmoother()
+    smoother = AngleSmoother()
     assert smoother.update(0.0, None) is None
     assert smoother.update(0.1, float("nan")) is None
     first = smoother.update(0.2, 7.0)
     assert first is not None
-    assert first.yaw_deg == 7.0
-    assert first.yaw_rate_dps == 0.0
-    assert first.yaw_std_deg == pytest.approx(SmoothingConfig().initial_std_deg)
+    assert first.angle_deg == 7.0
+    assert first.rate_dps == 0.0
+    assert first.std_deg == pytest.approx(SmoothingConfig().initial_std_deg)
 
 
 def test_rate_follows_a_ramp() -> None:
     truth = np.linspace(0.0, 60.0, 61)  # 60 deg over 2 s = 30 deg/s... at 30 fps: 1 deg/frame
-    smoother = YawSmoother()
+    smoother = AngleSmoother()
     result = None
     for i, value in enumerate(truth):
         result = smoother.update(i / FPS, float(value))
     assert result is not None
-    assert result.yaw_rate_dps == pytest.approx(30.0, abs=1.0)
-    assert result.yaw_deg == pytest.approx(60.0, abs=0.5)
+    assert result.rate_dps == pytest.approx(30.0, abs=1.0)
+    assert result.angle_deg == pytest.approx(60.0, abs=0.5)
 
 
 def test_dt_comes_from_timestamps() -> None:
     """The same track sampled at 10 fps and 30 fps ends at the same rate estimate."""
     rates = []
     for fps in (10.0, 30.0):
-        smoother = YawSmoother()
+        smoother = AngleSmoother()
         result = None
         for i in range(int(3 * fps)):
             result = smoother.update(i / fps, 20.0 * i / fps)
         assert result is not None
-        rates.append(result.yaw_rate_dps)
+        rates.append(result.rate_dps)
     np.testing.assert_allclose(rates, 20.0, atol=0.5)
 
 
 def test_non_increasing_time_raises() -> None:
-    smoother = YawSmoother()
+    smoother = AngleSmoother()
     smoother.update(1.0, 0.0)
     with pytest.raises(ValueError, match="increase"):
         smoother.update(1.0, 0.0)
+
+
+def eased_turns(fps: float = 15.0) -> tuple[np.ndarray, np.ndarray]:
+    """Times and yaws of a drive-like track: holds and 0.5 s cosine-eased turns of 35-40 deg."""
+    t = np.arange(int(12 * fps)) / fps
+    keys = [(0.0, 0.0), (2.0, 40.0), (5.0, 0.0), (7.0, -35.0), (9.0, 0.0)]
+    yaw = np.zeros_like(t)
+    previous = 0.0
+    for start, target in keys:
+        progress = np.clip((t - start) / 0.5, 0.0, 1.0)
+        yaw = np.where(
+            t >= start, previous + (target - previous) * (0.5 - 0.5 * np.cos(np.pi * progress)), yaw
+        )
+        previous = target
+    return t, yaw
+
+
+def run_smoother(t: np.ndarray, values: np.ndarray) -> np.ndarray:
+    smoother = AngleSmoother()
+    out = np.full(len(t), np.nan)
+    for i, (t_s, value) in enumerate(zip(t, values, strict=True)):
+        result = smoother.update(float(t_s), None if np.isnan(value) else float(value))
+        if result is not None:
+            out[i] = result.angle_deg
+    return out
+
+
+def test_a_clean_drive_passes_through_without_overshoot() -> None:
+    t, truth = eased_turns()
+    estimate = run_smoother(t, truth)
+    assert float(np.max(np.abs(estimate - truth))) < 0.5  # no lag worth a glance
+    assert excursion_deg(estimate, truth, t) == 0.0  # no overshoot, no ringing
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_noisy_drive_is_improved_and_never_leaves_the_raw_range(seed: int) -> None:
+    t, truth = eased_turns()
+    raw = truth + np.random.default_rng(seed).normal(0.0, 3.0, truth.shape)
+    estimate = run_smoother(t, raw)
+    assert np.mean(np.abs(estimate - truth)) < 0.9 * np.mean(np.abs(raw - truth))
+    for i in range(len(t)):  # causal bound: the accepted raw values of the last 0.5 s
+        recent = raw[(t > t[i] - 0.5) & (t <= t[i])]
+        assert recent.min() - 1e-9 <= estimate[i] <= recent.max() + 1e-9
+
+
+def test_jumps_of_an_image_folder_do_not_run_away() -> None:
+    """Abrupt poses one after another (an image folder): today's filter extrapolated to -92 deg
+    where the raw yaw never went below -57; the estimate must stay within the raw range."""
+    values = np.array([0, 15, 30, 45, 60, 0, -15, -30, -45, -57, 0, 30, 60, 67, 0] * 3, float)
+    t = np.arange(len(values)) / 30.0
+    estimate = run_smoother(t, values)
+    assert np.nanmin(estimate) >= values.min() and np.nanmax(estimate) <= values.max()
+    assert excursion_deg(estimate, values, t) == 0.0
+
+
+def test_a_gap_holds_the_last_estimate_instead_of_extrapolating() -> None:
+    t = np.arange(60) / 30.0
+    values = np.where(t < 1.0, 60.0 * t, np.nan)  # turning at 60 deg/s when the face is lost
+    estimate = run_smoother(t, values)
+    held = estimate[t >= 1.0]
+    np.testing.assert_allclose(held, estimate[np.flatnonzero(t < 1.0)[-1]], atol=1e-9)
+
+
+def test_noise_is_measured_from_the_series() -> None:
+    t = np.arange(600) / 15.0
+    rng = np.random.default_rng(0)
+    turning = 20.0 * np.sin(t)
+    assert robust_noise_std_deg(t, turning + rng.normal(0.0, 3.0, t.size)) == pytest.approx(
+        3.0, abs=0.3
+    )
+    assert robust_noise_std_deg(t, turning) < 0.05  # a smooth turn is not noise
+    assert np.isnan(robust_noise_std_deg(t[:2], turning[:2]))
+    irregular = np.cumsum(np.random.default_rng(1).uniform(0.03, 0.1, 400))
+    residual = extrapolation_residuals(irregular, rng.normal(0.0, 2.0, 400))
+    assert float(np.std(residual)) == pytest.approx(2.0, rel=0.15)  # scaled for any dt
+    smoother = AngleSmoother()
+    for i, value in enumerate(turning + rng.normal(0.0, 3.0, t.size)):
+        smoother.update(float(t[i]), float(value))
+    assert smoother.state.measurement_std_deg == pytest.approx(3.0, abs=0.8)
+
+
+@pytest.mark.parametrize("dt_s", [1 / 30, 1 / 15, 0.4])
+def test_the_process_noise_is_filterpys_piecewise_white_acceleration(dt_s: float) -> None:
+    from filterpy.common import Q_discrete_white_noise
+
+    from roadgaze.pose.smoothing import constant_velocity_model
+
+    transition, noise = constant_velocity_model(dt_s, 300.0)
+    np.testing.assert_allclose(noise, Q_discrete_white_noise(dim=2, dt=dt_s, var=300.0**2))
+    np.testing.assert_array_equal(transition, [[1.0, dt_s], [0.0, 1.0]])

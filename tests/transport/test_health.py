@@ -43,9 +43,14 @@ def records(
         yield FrameRecord(sample(t_s, yaw_deg), monitor.verdict, alerts)
 
 
+AWAY_YAW_DEG = -30.0
+"""Right of the road, short of the right mirror: zone `away` (+45 deg is the left mirror, which
+raises no long_distraction)."""
+
+
 def glance(frames: int) -> list[tuple[float, float | None]]:
-    """1 s ahead, 4 s at 45 deg, then ahead, at 30 fps."""
-    return [(f / 30, 45.0 if 1.0 <= f / 30 < 5.0 else 0.0) for f in range(frames)]
+    """1 s ahead, 4 s at -30 deg (zone away), then ahead, at 30 fps."""
+    return [(f / 30, AWAY_YAW_DEG if 1.0 <= f / 30 < 5.0 else 0.0) for f in range(frames)]
 
 
 def test_publisher_sends_every_record_and_each_alert_in_order() -> None:
@@ -71,17 +76,20 @@ def test_yaw_message_from_a_record_keeps_every_value() -> None:
     message = YawMessage.from_record(record, "car-9", 7, 123.0)
     assert (message.vehicle_id, message.seq, message.wall_time) == ("car-9", 7, 123.0)
     assert (message.t_s, message.frame, message.face) == (39 / 30, 39, True)
-    assert (message.yaw_deg, message.gaze, message.on_road) == (45.0, "off_road", False)
+    assert (message.yaw_deg, message.gaze, message.on_road) == (AWAY_YAW_DEG, "off_road", False)
+    assert (message.zone, message.eyes_on_road) == ("away", False)
+    assert message.schema_id == "roadgaze.yaw/2"
     assert json.loads(message.to_json_bytes())["gaze"] == "off_road"
 
 
 def test_verdict_text_for_the_annotated_video_names_gaze_time_and_alerts() -> None:
     lines = [
-        verdict_text(record) for record in records(FIXED, [(f / 30, 45.0) for f in range(121)])
+        verdict_text(record)
+        for record in records(FIXED, [(f / 30, AWAY_YAW_DEG) for f in range(121)])
     ]
-    assert lines[30] == "gaze off_road  off road 1.0 s  in window 1.0 s"
+    assert lines[30] == "zone away  off road 1.0 s  in window 1.0 s"
     assert lines[90] == (
-        "gaze off_road  off road 3.0 s  in window 3.0 s  ALERT long_distraction:warning"
+        "zone away  off road 3.0 s  in window 3.0 s  ALERT long_distraction:warning"
     )
 
 
@@ -118,7 +126,7 @@ def test_alerts_are_gated_on_the_speed_received(speed_payload: bytes | None, exp
     link = FakeLink(speed=speed)
     keys = Keys.from_config(FIXED.zenoh)
     health = Health(FIXED, keys, link, "test")
-    yaws: list[float | None] = [45.0 if 1.0 <= f / 30 < 5.0 else 0.0 for f in range(180)]
+    yaws: list[float | None] = [AWAY_YAW_DEG if 1.0 <= f / 30 < 5.0 else 0.0 for f in range(180)]
     pipeline = Pipeline.from_config(FIXED, ScriptedDetector(yaws), speed=speed.kmh)
     pipeline.run(ListSource(len(yaws)), [health, BusPublisher(keys.vehicle_id, link)])
     assert len(link.alerts) == expected

@@ -219,7 +219,7 @@ def test_subscriber_in_another_process_receives_valid_yaw_and_alert() -> None:
     yaw, alert = received[0]["payload"], received[-1]["payload"]
     jsonschema.validate(yaw, SCHEMAS["yaw"])
     jsonschema.validate(alert, SCHEMAS["alert"])
-    assert yaw["schema"] == "roadgaze.yaw/1" and yaw["vehicle_id"] == "test-car"
+    assert yaw["schema"] == "roadgaze.yaw/2" and yaw["vehicle_id"] == "test-car"
     assert alert["kind"] == "long_distraction" and alert["off_road_s"] == 3.0
     assert received[-1]["key"] == "vehicle/test-car/dms/alert"
     assert gone is not None and json.loads(gone)["payload"] == {"alive": False}

@@ -16,9 +16,10 @@ def register(subparsers: Any) -> None:
         "demo",
         parents=[common_options()],
         help="see it work: a synthetic drive through the whole service, alerts over Zenoh",
-        description="Render a short drive of a real face (road, a long glance away, a few short "
-        "ones, back to the road), run the full service over it (landmarks, Center-CE, Kalman "
-        "smoother, monitor, Zenoh publisher on 127.0.0.1) with a Zenoh subscriber in the same "
+        description="Render a short drive of a real face (road, a long look into the lap, a few "
+        "short glances, back to the road), run the full service over it (landmarks, full-range "
+        "yaw, pitch, smoother, monitor with zones, Zenoh publisher on 127.0.0.1) with a Zenoh "
+        "subscriber in the same "
         "run, print each alert as the subscriber receives it, and write drive.mp4, truth.csv, "
         "frames.jsonl, alerts.jsonl, yaw.png and annotated.mp4 into the output folder.",
     )

@@ -18,8 +18,10 @@ def register(subparsers: Any) -> None:
         parents=[common_options()],
         help="estimate the driver's head yaw in still images (one JSON line per image)",
         description="Run MediaPipe and the five yaw models on each image and print one JSON "
-        "object per image: file, face, yaw_deg (Center-CE), models, x_left, x_right, x_center, "
-        "roll_deg, mediapipe_yaw_deg. Yaw > 0: head turned to the person's own left. An image "
+        "object per image: file, face, yaw_deg (the service's, full range by default), models, "
+        "pitch_deg, pitch_geometric_deg, zone (neutral 0), mediapipe_yaw_deg, "
+        "mediapipe_pitch_deg, x_left, x_right, x_center, roll_deg. Yaw > 0: head turned to the "
+        "person's own left; pitch > 0: looking up. An image "
         "that cannot be read gives an object with 'error' and the others are still processed "
         "(exit code 1 if any image could not be read).",
     )
@@ -39,7 +41,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     jobs = [(path, str(path)) for path in args.images]
     failures = 0
     for estimate in estimate_images(
-        jobs, config.landmarks, model_path, constants, workers=max(1, args.workers)
+        jobs, config.landmarks, model_path, constants, workers=max(1, args.workers), config=config
     ):
         print(json.dumps(estimate.to_json_dict()), flush=True)
         if estimate.error is not None:

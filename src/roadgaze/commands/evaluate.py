@@ -1,4 +1,5 @@
-"""`roadgaze eval DATASET_DIR`: accuracy of every yaw model and of MediaPipe's own yaw."""
+"""`roadgaze eval DATASET_DIR`: accuracy of every yaw model, the service's yaw and pitch, and
+MediaPipe's own yaw."""
 
 from __future__ import annotations
 
@@ -16,10 +17,12 @@ def register(subparsers: Any) -> None:
         "eval",
         parents=[common_options()],
         help="score the yaw models against a data set's ground_truth.csv",
-        description="Estimate yaw on every image listed in DATASET_DIR/ground_truth.csv "
+        description="Estimate the pose on every image listed in DATASET_DIR/ground_truth.csv "
         "(columns file,yaw_deg[,pitch_deg]; rows with |pitch_deg| = 90 are skipped) and print "
-        "MAE, RMSE, median error and detection rate per model and for MediaPipe's own yaw, for "
-        "|yaw| <= 60 deg, for all rows, and per 15 deg bin.",
+        "MAE, RMSE, median error and detection rate per yaw model, for the service's yaw and for "
+        "MediaPipe's own yaw, for |yaw| <= 60 deg, for all rows, and per 15 deg bin; with pitch "
+        "labels also the pitch's rank correlation and mean error per tilt and the lap "
+        "classification (tilt -60 against |tilt| <= 15). Stills take neutral 0.",
     )
     parser.add_argument("dataset", type=Path, metavar="DATASET_DIR")
     parser.add_argument("--report", type=Path, metavar="JSON", help="write all figures as JSON")
@@ -84,6 +87,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
             workers=max(1, args.workers),
             progress=not args.no_progress,
             description="eval",
+            config=config,
         )
     )
     report = evaluate(str(args.dataset), truths, estimates, skipped, constants)

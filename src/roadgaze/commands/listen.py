@@ -68,10 +68,12 @@ def format_pretty(kind: str, vehicle: str, payload: dict[str, Any] | None, raw: 
     if kind == "yaw":
         yaw = payload.get("yaw_deg")
         yaw_text = "    --  " if yaw is None else f"{yaw:+7.1f}°"
-        return (
-            f"yaw    {vehicle} #{payload.get('seq')} t={payload.get('t_s', 0.0):.2f}s "
-            f"{yaw_text} {payload.get('gaze')}"
-        )
+        line = f"yaw    {vehicle} #{payload.get('seq')} t={payload.get('t_s', 0.0):.2f}s {yaw_text}"
+        if "zone" not in payload:  # roadgaze.yaw/1
+            return f"{line} {payload.get('gaze')}"
+        pitch = payload.get("pitch_deg")
+        pitch_text = "    --  " if pitch is None else f"{pitch:+7.1f}°"
+        return f"{line} pitch {pitch_text} {payload.get('zone') or payload.get('gaze')}"
     if kind == "state":
         transport = payload.get("transport", {})
         return (

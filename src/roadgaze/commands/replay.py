@@ -27,10 +27,12 @@ def register(subparsers: Any) -> None:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "replay",
         parents=[common_options()],
-        help="run the yaw pipeline over a video and write one record per frame",
-        description="Run capture -> landmarks -> Center-CE yaw -> Kalman smoother -> monitor "
-        "over a video file (or image folder, or camera) and write one JSON object per frame. A "
-        "progress bar with fps and ETA goes to stderr.",
+        help="run the pose pipeline over a video and write one record per frame",
+        description="Run capture -> landmarks -> yaw, pitch, roll -> smoother -> monitor (zones) "
+        "over a video file (or image folder, or camera) and write one JSON object per frame. The "
+        "records are written line by line; at the normal end the files are rewritten once with "
+        "the offline (RTS) yaw_offline_deg and pitch_offline_deg filled (alerts stay computed "
+        "from the causal estimate). A progress bar with fps and ETA goes to stderr.",
     )
     add_arguments(parser)
     parser.set_defaults(handler=run)
@@ -171,4 +173,22 @@ def run(args: argparse.Namespace, config: Config) -> int:
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
     report(args, summary, stats)
+    fill_offline(args, config)
     return 0
+
+
+def fill_offline(args: argparse.Namespace, config: Config) -> None:
+    """At the normal end of a replay: the offline columns of the written record files (not of
+    stdout), each file rewritten atomically; a file that cannot be done keeps its nulls."""
+    from roadgaze.errors import RoadgazeError
+    from roadgaze.outputs import fill_offline_columns
+
+    paths = [Path(args.out)] if args.out is not None and args.out != "-" else []
+    paths += [args.csv] if args.csv is not None else []
+    for path in paths:
+        try:
+            fill_offline_columns(path, config.smoothing)
+        except RoadgazeError as exc:
+            print(f"replay {args.source}: offline columns left null: {exc}", file=sys.stderr)
+            continue
+        print(f"replay {args.source}: offline columns filled in {path}", file=sys.stderr)

@@ -1,9 +1,11 @@
-"""`roadgaze synth`: a video of a real face turning to known yaws, with its truth CSV."""
+"""`roadgaze synth`: a video of a real face turning to known poses, with its truth CSV, and the
+measurements against that truth (yaw sweep, pitch grid, a clip through the pose stage)."""
 
 from __future__ import annotations
 
 import argparse
 import re
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -29,11 +31,15 @@ def register(subparsers: Any) -> None:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "synth",
         parents=[common_options()],
-        help="render a ground-truth clip of a real face turning to given yaws (or --measure)",
-        description="Render a video of the face in one photo turning to the yaws of a timeline "
-        "(the photo's MediaPipe face mesh lifted to 3D, turned about a neck pivot and re-rendered) "
-        "and write <stem>.truth.csv beside it (t_s,yaw_deg,pitch_deg). With --measure, instead "
-        "sweep yaw over stills and print how well the landmark stage + Center-CE recover it.",
+        help="render a ground-truth clip of a real face turning to given poses (or measure)",
+        description="Render a video of the face in one photo turning to the poses of a timeline "
+        "(the photo's MediaPipe face mesh lifted to 3D, nodded and turned about a neck pivot and "
+        "re-rendered) and write <stem>.truth.csv beside it (t_s,yaw_deg,pitch_deg). With "
+        "--measure, instead sweep yaw over frames and print how well the landmark stage and the "
+        "yaw model recover it; --measure --pitch: a yaw x pitch grid of stills, pitch per |pitch| "
+        "range and the zones; --measure-clip: render the timeline and print the raw, online and "
+        "offline (RTS) yaw and pitch errors, the smoothers' overshoot, pitch per |pitch| range "
+        "and the zones against the truth.",
         epilog="Timeline: comma-separated YAW[/PITCH]:SECONDS keyframes in degrees and seconds; "
         "each segment turns to its pose during the first --transition seconds (cosine ease) and "
         f"holds it. Example: {EXAMPLE_TIMELINE}. Yaw > 0: head turned to the person's own left.",
@@ -42,7 +48,8 @@ def register(subparsers: Any) -> None:
         "--timeline",
         default=EXAMPLE_TIMELINE,
         metavar="SPEC",
-        help=f"keyframes YAW[/PITCH]:SECONDS,... (default {EXAMPLE_TIMELINE})",
+        help=f"keyframes YAW[/PITCH]:SECONDS,... (default {EXAMPLE_TIMELINE}); with "
+        "--measure-clip also 'demo' (the demo's drive) or 'pose' (a yaw/pitch drive, the default)",
     )
     parser.add_argument("--out", type=Path, metavar="VIDEO", help="output .mp4, .avi or .mkv")
     parser.add_argument(
@@ -77,13 +84,73 @@ def register(subparsers: Any) -> None:
         help="run the landmarker on each still in IMAGE mode (default: VIDEO mode over the sweep)",
     )
     measure.add_argument("--csv", type=Path, metavar="FILE", help="write per-yaw results here")
+    measure.add_argument(
+        "--pitch",
+        action="store_true",
+        help="with --measure: a yaw x pitch grid of stills (yaw step 15, pitch -40..40 step 5): "
+        "pitch per |pitch| range for each pitch estimator, and the zones",
+    )
+    measure.add_argument(
+        "--measure-clip",
+        action="store_true",
+        help="render --timeline, run landmarks and the pose stage over it (VIDEO mode) and print "
+        "the smoothers' errors and overshoot, pitch per |pitch| range and the zones",
+    )
+    measure.add_argument(
+        "--noise",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="with --measure-clip: also add white noise of DEG to the raw yaw and pitch",
+    )
+    measure.add_argument(
+        "--seeds", type=int, default=5, metavar="N", help="noise seeds (default 5)"
+    )
     parser.set_defaults(handler=run)
+
+
+def clip_timeline(text: str) -> str:
+    """The timeline `--measure-clip` renders: 'pose', 'demo' or a spec of its own."""
+    if text == "pose":
+        from roadgaze.synth import POSE_TIMELINE
+
+        return POSE_TIMELINE
+    if text == "demo":
+        from roadgaze.demo import DRIVE_TIMELINE
+
+        return DRIVE_TIMELINE
+    return text
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.synth import load_photo, parse_timeline, render_clip, truth_path_for
 
     size = parse_size(args.size)
+    if args.measure_clip:
+        from roadgaze.synth import format_clip_measurement, measure_clip
+
+        if not 0.0 <= args.noise <= 30.0:
+            raise ConfigError(f"--noise must be within 0..30 deg, found {args.noise}")
+        if not 1 <= args.seeds <= 100:
+            raise ConfigError(f"--seeds must be within 1..100, found {args.seeds}")
+        timeline = args.timeline if args.timeline != EXAMPLE_TIMELINE else "pose"
+        parsed = parse_timeline(clip_timeline(timeline), args.transition)
+        clip = measure_clip(
+            parsed,
+            config,
+            photo=args.photo,
+            size=size,
+            fps=args.fps,
+            noise_deg=args.noise,
+            seeds=args.seeds,
+        )
+        print(format_clip_measurement(replace(clip, timeline=timeline)))
+        return 0
+    if args.measure and args.pitch:
+        from roadgaze.synth import format_pitch_measurement, measure_pitch_recovery
+
+        print(format_pitch_measurement(measure_pitch_recovery(config, args.photo, size)))
+        return 0
     if args.measure:
         from roadgaze.synth import format_measurement, measure_yaw_recovery, write_measurement_csv
 

@@ -1,4 +1,4 @@
-"""Evaluation: yaw on still images scored against ground truth, and the paper's experiments."""
+"""Evaluation: pose on still images scored against ground truth, and the paper's experiments."""
 
 from roadgaze.evaluation.ground_truth import GroundTruth, load_ground_truth
 from roadgaze.evaluation.images import (
@@ -15,6 +15,11 @@ from roadgaze.evaluation.landmark_choices import (
     format_landmark_comparison,
     rescore_landmark_choice,
 )
+from roadgaze.evaluation.pitch import (
+    PitchReport,
+    evaluate_pitch,
+    format_pitch_report,
+)
 from roadgaze.evaluation.refit import format_refit, refit_constants
 from roadgaze.evaluation.report import (
     METHOD_LABELS,
@@ -22,6 +27,7 @@ from roadgaze.evaluation.report import (
     PAPER_RANGE_DEG,
     PEER,
     PREDICTION_COLUMNS,
+    SERVICE,
     EvaluationReport,
     align,
     evaluate,
@@ -39,10 +45,12 @@ __all__ = [
     "PAPER_RANGE_DEG",
     "PEER",
     "PREDICTION_COLUMNS",
+    "SERVICE",
     "ErrorStats",
     "EvaluationReport",
     "GroundTruth",
     "ImageEstimate",
+    "PitchReport",
     "RangeStats",
     "align",
     "compare_landmark_choices",
@@ -51,7 +59,9 @@ __all__ = [
     "estimate_image",
     "estimate_images",
     "evaluate",
+    "evaluate_pitch",
     "format_landmark_comparison",
+    "format_pitch_report",
     "format_refit",
     "format_report",
     "load_ground_truth",

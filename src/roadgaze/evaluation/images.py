@@ -1,4 +1,5 @@
-"""Yaw on still images: the landmark stage and all five yaw models per file, in worker processes.
+"""Pose on still images: the landmark stage, all five yaw models and the service's yaw, pitch,
+roll and zone (neutral 0) per file, in worker processes.
 
 `estimate_images` yields one `ImageEstimate` per file, in order; a file that cannot be read gives
 an estimate with `error` set, and the others still run.
@@ -16,10 +17,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from roadgaze.config import LandmarksConfig
+from roadgaze.config import Config, LandmarksConfig
 from roadgaze.errors import SourceError
+from roadgaze.monitor.zones import ZoneMap
+from roadgaze.pose.estimator import PoseEstimator
 from roadgaze.pose.geometry import PAPER_CONSTANTS, YAW_MODELS, FaceModelConstants
-from roadgaze.types import Detection, LandmarkDetector
+from roadgaze.pose.pitch import midline_pitch_deg
+from roadgaze.types import Detection, FaceFeatures, LandmarkDetector
 
 MODEL_NAMES: tuple[str, ...] = tuple(YAW_MODELS)
 """The paper's five models, in the paper's order."""
@@ -27,11 +31,12 @@ MODEL_NAMES: tuple[str, ...] = tuple(YAW_MODELS)
 
 @dataclass(frozen=True, slots=True)
 class ImageEstimate:
-    """The driver's yaw in one image by every model, or why there is none.
+    """The driver's pose in one image by every model, or why there is none.
 
     `face` is False when no face was found or the file could not be used (`error` then says
-    why). Yaw values are degrees in the project convention; None where a model cannot explain
-    the measured geometry.
+    why). Angles are degrees in the project convention (yaw > 0 = the person's own left, pitch > 0
+    = up); None where a model cannot explain the measured geometry. The service's values take
+    neutral 0 (a still has no learned neutral pose).
     """
 
     file: str
@@ -48,10 +53,20 @@ class ImageEstimate:
     error: str | None = None
     landmarks_px: npt.NDArray[np.float32] | None = None
     """The driver's (478, 3) landmarks, kept for re-scoring other landmark choices."""
+    service_yaw_deg: float | None = None
+    """The service's yaw (`geometry.model`, full range by default)."""
+    pitch_deg: float | None = None
+    """The service's pitch (`pose.pitch_model`; neutral 0)."""
+    pitch_geometric_deg: float | None = None
+    """The vertical CE model's pitch (P4), for comparison."""
+    zone: str | None = None
+    """The glance zone of the service's yaw and pitch (neutral 0, no previous zone)."""
 
     @property
     def yaw_deg(self) -> float | None:
-        """Center-CE, the paper's best model."""
+        """The service's yaw; Center-CE where it was not computed."""
+        if self.service_yaw_deg is not None or not self.face:
+            return self.service_yaw_deg
         return self.yaw_deg_by_model.get("center_ce")
 
     def to_json_dict(self) -> dict[str, Any]:
@@ -62,6 +77,9 @@ class ImageEstimate:
             "n_faces": self.n_faces,
             "yaw_deg": self.yaw_deg,
             "models": {name: self.yaw_deg_by_model.get(name) for name in MODEL_NAMES},
+            "pitch_deg": self.pitch_deg,
+            "pitch_geometric_deg": self.pitch_geometric_deg,
+            "zone": self.zone,
             "mediapipe_yaw_deg": self.mediapipe_yaw_deg,
             "mediapipe_pitch_deg": self.mediapipe_pitch_deg,
             "x_left": self.x_left_px,
@@ -119,14 +137,52 @@ def read_image(path: Path) -> npt.NDArray[np.uint8]:
     return np.asarray(image, dtype=np.uint8)
 
 
+@dataclass(frozen=True, slots=True)
+class StillPose:
+    """The service's pose models for stills: yaw, pitch (neutral 0) and the zone classifier."""
+
+    pose: PoseEstimator
+    zones: ZoneMap
+
+    @classmethod
+    def from_config(cls, config: Config) -> StillPose:
+        return cls(PoseEstimator.from_config(config), config.monitor.zone_map())
+
+    def estimate(self, face: FaceFeatures) -> tuple[float | None, float | None, str | None]:
+        """Yaw, pitch and zone of one face as a first sample with neutral 0."""
+        yaw = self.pose.raw_yaw_deg(face)
+        pitch = self.pose.raw_pitch_deg(face, 0.0)
+        zone = None if yaw is None else self.zones.classify(yaw, pitch or 0.0, None)
+        return yaw, pitch, zone
+
+
+def _geometric_pitch(face: FaceFeatures) -> float | None:
+    if face.y_top_px is None or face.y_bottom_px is None or face.y_center_px is None:
+        return None
+    return _finite_or_none(
+        float(midline_pitch_deg(face.y_top_px, face.y_bottom_px, face.y_center_px))
+    )
+
+
 def estimate_from_detection(
-    name: str, detection: Detection, constants: FaceModelConstants = PAPER_CONSTANTS
+    name: str,
+    detection: Detection,
+    constants: FaceModelConstants = PAPER_CONSTANTS,
+    still: StillPose | None = None,
 ) -> ImageEstimate:
-    """The driver's estimate from one detection result."""
+    """The driver's estimate from one detection result (`still`: the service's models, by
+    default those of the default configuration with `constants`)."""
     driver = detection.driver
     if driver is None:
         return ImageEstimate(file=name, face=False, n_faces=len(detection.faces))
+    if still is None:
+        still = StillPose(PoseEstimator(constants=constants), Config().monitor.zone_map())
+    service_yaw, pitch, zone = still.estimate(driver)
     return ImageEstimate(
+        service_yaw_deg=service_yaw,
+        pitch_deg=pitch,
+        pitch_geometric_deg=_geometric_pitch(driver),
+        zone=zone,
         file=name,
         face=True,
         n_faces=len(detection.faces),
@@ -149,15 +205,16 @@ def estimate_image(
     path: Path,
     constants: FaceModelConstants = PAPER_CONSTANTS,
     name: str | None = None,
+    still: StillPose | None = None,
 ) -> ImageEstimate:
-    """Run the landmark stage and the yaw models on one file; errors become `error`, not raise."""
+    """Run the landmark stage and the pose models on one file; errors become `error`, not raise."""
     label = str(path) if name is None else name
     try:
         image = read_image(path)
         detection = detector.detect(image)
     except (SourceError, ValueError) as exc:
         return ImageEstimate(file=label, face=False, error=str(exc))
-    return estimate_from_detection(label, detection, constants)
+    return estimate_from_detection(label, detection, constants, still)
 
 
 _worker: dict[str, Any] = {}
@@ -170,7 +227,10 @@ def _close_worker() -> None:
 
 
 def _init_worker(
-    landmarks_config: LandmarksConfig, model_path: Path, constants: FaceModelConstants
+    landmarks_config: LandmarksConfig,
+    model_path: Path,
+    constants: FaceModelConstants,
+    config: Config,
 ) -> None:
     from multiprocessing.util import Finalize
 
@@ -178,6 +238,7 @@ def _init_worker(
 
     _worker["detector"] = MediaPipeLandmarker(landmarks_config, model_path, video=False)
     _worker["constants"] = constants
+    _worker["still"] = StillPose.from_config(config)
     # Runs when the worker leaves its loop, while MediaPipe's threads are still alive (an atexit
     # hook would run after they are gone and fail).
     Finalize(None, _close_worker, exitpriority=10)
@@ -185,7 +246,7 @@ def _init_worker(
 
 def _worker_estimate(job: tuple[Path, str]) -> ImageEstimate:
     path, name = job
-    return estimate_image(_worker["detector"], path, _worker["constants"], name)
+    return estimate_image(_worker["detector"], path, _worker["constants"], name, _worker["still"])
 
 
 def estimate_images(
@@ -196,29 +257,33 @@ def estimate_images(
     workers: int = 1,
     progress: bool = False,
     description: str = "images",
+    config: Config | None = None,
 ) -> Iterator[ImageEstimate]:
     """One `ImageEstimate` per (path, display name), in input order.
 
     `workers` > 1 uses that many processes (spawned, each with its own landmarker); the progress
-    bar, when asked for, goes to stderr.
+    bar, when asked for, goes to stderr. `config` chooses the service's yaw and pitch models and
+    zones (default: the built-in configuration).
     """
     from tqdm import tqdm
 
+    config = config if config is not None else Config()
     bar = tqdm(total=len(jobs), desc=description, unit="img", disable=not progress, leave=False)
     try:
         if workers <= 1 or len(jobs) <= 1:
             from roadgaze.landmarks.landmarker import MediaPipeLandmarker
 
+            still = StillPose.from_config(config)
             with MediaPipeLandmarker(landmarks_config, model_path, video=False) as detector:
                 for path, name in jobs:
-                    yield estimate_image(detector, path, constants, name)
+                    yield estimate_image(detector, path, constants, name, still)
                     bar.update(1)
             return
         context = multiprocessing.get_context("spawn")
         with context.Pool(
             processes=workers,
             initializer=_init_worker,
-            initargs=(landmarks_config, model_path, constants),
+            initargs=(landmarks_config, model_path, constants, config),
         ) as pool:
             for estimate in pool.imap(_worker_estimate, jobs, chunksize=8):
                 yield estimate

@@ -1,5 +1,6 @@
-"""Scoring estimates against ground truth: per model and for MediaPipe's own yaw, over
-|yaw| <= 60 deg, over all rows and per 15 deg bin; the report as text, JSON, CSV and a plot.
+"""Scoring estimates against ground truth: per model, for the service's yaw and for MediaPipe's
+own yaw, over |yaw| <= 60 deg, over all rows and per 15 deg bin; pitch against the tilt and the
+lap classification (`roadgaze.evaluation.pitch`); the report as text, JSON, CSV and a plot.
 
 Scoring: detection rate = images with a face / images; a model's errors (estimate minus truth)
 are taken over the images where a face was found and the model could explain the geometry
@@ -21,19 +22,23 @@ import numpy.typing as npt
 
 from roadgaze.evaluation.ground_truth import GroundTruth
 from roadgaze.evaluation.images import MODEL_NAMES, ImageEstimate
+from roadgaze.evaluation.pitch import PitchReport, evaluate_pitch, format_pitch_report
 from roadgaze.evaluation.stats import ErrorStats, error_stats
 from roadgaze.pose.geometry import PAPER_CONSTANTS, FaceModelConstants
 from roadgaze.types import FloatArray
 
 PEER = "mediapipe"
 """MediaPipe's own yaw from its facial transformation matrix, the peer we compare against."""
-METHODS: tuple[str, ...] = (*MODEL_NAMES, PEER)
+SERVICE = "service"
+"""The service's yaw (`geometry.model`: the full-range blend by default)."""
+METHODS: tuple[str, ...] = (*MODEL_NAMES, SERVICE, PEER)
 METHOD_LABELS: Mapping[str, str] = {
     "cylindrical": "Cylindrical",
     "ellipsoidal": "Ellipsoidal",
     "ce": "CE",
     "center_ce": "Center-CE",
     "boundary_ce": "Boundary-CE",
+    SERVICE: "Service yaw",
     PEER: "MediaPipe matrix",
 }
 PAPER_RANGE_DEG = 60.0
@@ -47,7 +52,14 @@ PREDICTION_COLUMNS: tuple[str, ...] = (
     "yaw_center_ce",
     "yaw_boundary_ce",
     "yaw_mediapipe",
+    "yaw_deg",
+    "pitch_deg",
+    "roll_deg",
+    "zone",
+    "pitch_mediapipe",
+    "pitch_geometric",
 )
+"""`yaw_deg`, `pitch_deg`, `zone`: the service's (neutral 0); `roll_deg`: the eye line's."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,6 +82,8 @@ def align(truths: Sequence[GroundTruth], estimates: Sequence[ImageEstimate]) -> 
         estimates_deg[name] = np.array([math.nan if v is None else v for v in values])
     peer = [e.mediapipe_yaw_deg for e in estimates]
     estimates_deg[PEER] = np.array([math.nan if v is None else v for v in peer])
+    service = [e.yaw_deg for e in estimates]
+    estimates_deg[SERVICE] = np.array([math.nan if v is None else v for v in service])
     return ScoredSet(
         files=tuple(t.file for t in truths),
         true_yaw_deg=np.array([t.yaw_deg for t in truths], dtype=np.float64),
@@ -97,6 +111,7 @@ class EvaluationReport:
     """'abs_yaw_le_60' and 'all' -> method -> stats."""
     bins: tuple[BinStats, ...]
     refit: Mapping[str, Any] | None = None
+    pitch: PitchReport | None = None
 
     def to_json_dict(self) -> dict[str, Any]:
         return {
@@ -122,6 +137,7 @@ class EvaluationReport:
                 for b in self.bins
             ],
             "refit": self.refit,
+            "pitch": None if self.pitch is None else self.pitch.to_json_dict(),
         }
 
 
@@ -167,6 +183,7 @@ def evaluate(
         constants=constants,
         ranges=ranges,
         bins=tuple(bins),
+        pitch=evaluate_pitch(truths, estimates),
     )
 
 
@@ -211,6 +228,9 @@ def format_report(report: EvaluationReport) -> str:
             f"{b.center_deg:>5.0f} {first.n_images:>5} {fmt(100 * first.detection_rate, 1):>6} "
             + " ".join(f"{fmt(b.stats[m].mae_deg):>11}" for m in METHODS)
         )
+    if report.pitch is not None:
+        lines.append("")
+        lines.append(format_pitch_report(report.pitch))
     if report.refit is not None:
         lines.append("")
         from roadgaze.evaluation.refit import format_refit
@@ -233,7 +253,9 @@ def write_predictions(path: Path, estimates: Iterable[ImageEstimate]) -> None:
             writer.writerow(
                 [e.file, int(e.face)]
                 + [cell(e.yaw_deg_by_model.get(name)) for name in MODEL_NAMES]
-                + [cell(e.mediapipe_yaw_deg)]
+                + [cell(e.mediapipe_yaw_deg), cell(e.yaw_deg), cell(e.pitch_deg)]
+                + [cell(e.roll_deg), e.zone or ""]
+                + [cell(e.mediapipe_pitch_deg), cell(e.pitch_geometric_deg)]
             )
 
 
@@ -252,9 +274,11 @@ def save_plot(
     import matplotlib.pyplot as plt
 
     scored = align(truths, estimates)
-    figure, axes = plt.subplots(2, 3, figsize=(13, 8.5), sharex=True, sharey=True)
+    figure, axes = plt.subplots(2, 4, figsize=(17, 8.5), sharex=True, sharey=True)
     limit = max(90.0, float(np.max(np.abs(scored.true_yaw_deg))))
-    for axis, method in zip(axes.ravel(), METHODS, strict=True):
+    for axis in axes.ravel()[len(METHODS) :]:
+        axis.set_visible(False)
+    for axis, method in zip(axes.ravel(), METHODS, strict=False):
         estimate = scored.estimates_deg[method]
         valid = np.isfinite(estimate) & scored.face
         truth = scored.true_yaw_deg

@@ -132,3 +132,41 @@ def range_stats(
         (magnitude <= high_deg) if include_high else (magnitude < high_deg)
     )
     return RangeStats(label, low_deg, high_deg, error_stats(true_deg[inside], estimate_deg[inside]))
+
+
+def average_ranks(values: npt.ArrayLike) -> FloatArray:
+    """Ranks 1..n of `values`, ties sharing the mean of their ranks."""
+    data = np.asarray(values, dtype=np.float64)
+    order = np.argsort(data, kind="mergesort")
+    ranks = np.empty(data.size)
+    ranks[order] = np.arange(1, data.size + 1, dtype=np.float64)
+    _, inverse, counts = np.unique(data, return_inverse=True, return_counts=True)
+    sums = np.bincount(inverse, weights=ranks)
+    return np.asarray((sums / counts)[inverse], dtype=np.float64)
+
+
+def spearman(a: npt.ArrayLike, b: npt.ArrayLike) -> float:
+    """Spearman's rank correlation of the pairs where both are finite; NaN for fewer than three
+    pairs or a constant side."""
+    x = np.asarray(a, dtype=np.float64)
+    y = np.asarray(b, dtype=np.float64)
+    both = np.isfinite(x) & np.isfinite(y)
+    if np.count_nonzero(both) < 3:
+        return math.nan
+    rank_x, rank_y = average_ranks(x[both]), average_ranks(y[both])
+    if np.ptp(rank_x) == 0 or np.ptp(rank_y) == 0:
+        return math.nan
+    return float(np.corrcoef(rank_x, rank_y)[0, 1])
+
+
+def separation_auc(low: npt.ArrayLike, high: npt.ArrayLike) -> float:
+    """Probability that a finite value of `low` lies below one of `high` (ties count half): the
+    area under the ROC curve of telling the two apart by a threshold. NaN if either is empty."""
+    below = np.asarray(low, dtype=np.float64)
+    above = np.asarray(high, dtype=np.float64)
+    below, above = below[np.isfinite(below)], above[np.isfinite(above)]
+    if below.size == 0 or above.size == 0:
+        return math.nan
+    ranks = average_ranks(np.concatenate([below, above]))
+    rank_sum = float(ranks[below.size :].sum())
+    return (rank_sum - above.size * (above.size + 1) / 2.0) / (below.size * above.size)

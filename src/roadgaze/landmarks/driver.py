@@ -87,6 +87,9 @@ def unmirror(face: FaceFeatures, image_width_px: int) -> FaceFeatures:
         landmarks_px=points,
         mediapipe_yaw_deg=None if face.mediapipe_yaw_deg is None else -face.mediapipe_yaw_deg,
         mediapipe_pitch_deg=face.mediapipe_pitch_deg,
+        y_top_px=face.y_top_px,
+        y_bottom_px=face.y_bottom_px,
+        y_center_px=face.y_center_px,
         blendshapes=None if face.blendshapes is None else swap_sides(face.blendshapes),
         eye_contrast=None if face.eye_contrast is None else face.eye_contrast[::-1],
     )
@@ -133,6 +136,9 @@ def merge_mirrored(
                 landmarks_px=face.landmarks_px,
                 mediapipe_yaw_deg=_mean(face.mediapipe_yaw_deg, other.mediapipe_yaw_deg),
                 mediapipe_pitch_deg=_mean(face.mediapipe_pitch_deg, other.mediapipe_pitch_deg),
+                y_top_px=_mean(face.y_top_px, other.y_top_px),
+                y_bottom_px=_mean(face.y_bottom_px, other.y_bottom_px),
+                y_center_px=_mean(face.y_center_px, other.y_center_px),
                 blendshapes=_mean_scores(face.blendshapes, other.blendshapes),
                 eye_contrast=face.eye_contrast,
             )

@@ -9,7 +9,9 @@ are rotated about the eye midpoint so that the eye line is horizontal; then
   line (cheek height, below the eyes and above the mouth), and
 - the centre is the mean x of the nose tip (1) and the point just above it on the ridge (4),
 
-a choice measured on Pointing'04 subjects 1-10 against the alternatives (docs/landmarks.md).
+a choice measured on Pointing'04 subjects 1-10 against the alternatives (docs/landmarks.md). The
+pitch model's inputs are the roll-removed y of the forehead (10), the chin (152) and the nose
+tip (1) on the face's mid-line (docs/pose.md).
 
 Sign conventions: image x grows right, y down. `roll_deg` > 0 is a counter-clockwise head tilt as
 seen in the image. Yaw > 0 is the head turned to the person's own left (ISO 8855), which an
@@ -34,6 +36,10 @@ LEFT_EYE_OUTER = 263
 """The person's left eye, outer corner (image right for an unmirrored camera)."""
 NOSE_TIP = 1
 MOUTH_CORNERS = (61, 291)
+MIDLINE_TOP = 10
+"""Forehead, the top of the mesh on the face's mid-line (the pitch model's top point)."""
+MIDLINE_BOTTOM = 152
+"""Chin, the bottom of the mesh on the mid-line."""
 
 FACE_OVAL = (
     10, 338, 297, 332, 284, 251, 389, 356, 454, 323, 361, 288, 397, 365, 379, 378, 400, 377,
@@ -158,7 +164,8 @@ def features_from_landmarks(
     """The yaw models' inputs for one face from its (478, 3) landmarks in pixels (numpy only).
 
     `image_size_px` (width, height) enables the edge term of `quality`; `transformation_matrix`
-    (MediaPipe's 4x4) fills `mediapipe_yaw_deg` / `mediapipe_pitch_deg`. Raises ValueError for a
+    (MediaPipe's 4x4) fills `mediapipe_yaw_deg` / `mediapipe_pitch_deg`; the mid-line's `y_top_px`,
+    `y_bottom_px` and `y_center_px` are always filled. Raises ValueError for a
     wrong shape or non-finite landmarks.
     """
     points = np.asarray(landmarks_px, dtype=np.float32)
@@ -182,6 +189,9 @@ def features_from_landmarks(
     if transformation_matrix is not None:
         yaw_mp, pitch_mp = angles_from_matrix_deg(transformation_matrix)
     return FaceFeatures(
+        y_top_px=float(upright[MIDLINE_TOP, 1]),
+        y_bottom_px=float(upright[MIDLINE_BOTTOM, 1]),
+        y_center_px=float(upright[NOSE_TIP, 1]),
         x_left_px=x_left,
         x_right_px=x_right,
         x_center_px=x_center,

@@ -7,17 +7,24 @@ holds the current `MonitorState` and turns each sample into the frame's `Verdict
 
 Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monitor.md):
 
-- road ahead: `|yaw - neutral| <= road_half_width_deg`; once off road, the head must come back
-  within `road_half_width_deg - hysteresis_deg` to be on road again. `neutral` is fixed by
-  `neutral_yaw_deg` or learned slowly (time constant `neutral_time_constant_s`, clamped to
-  `+-neutral_limit_deg`) from on-road samples.
-- face lost: while the head was off road (or, with `turn_away_deg` set, past that angle), the
-  driver is taken as still turned away, i.e. off road; otherwise where they look is unknown and,
-  after `unavailable_s`, the driver is `driver_unavailable`.
-- `long_distraction`: off road continuously for `long_distraction_s` (level warning), raised to
+- zone: each sample with a face gets a glance zone from its yaw and pitch relative to the neutral
+  pose (`roadgaze.monitor.zones`: ordered rectangles, first match wins, else `away`, with
+  hysteresis). `road` is on road; every other zone is off road. `neutral` (yaw and pitch) is
+  fixed by `neutral_yaw_deg` / `neutral_pitch_deg` or learned from samples that look roughly
+  ahead (yaw within `road_half_width_deg` of the neutral, pitch within
+  +-`neutral_pitch_limit_deg`): a running mean at first, then a first-order filter of time
+  constant `neutral_time_constant_s`, clamped to +-`neutral_limit_deg` /
+  `neutral_pitch_limit_deg`.
+- face lost: while the head was off road (or, with `turn_away_deg` set, past that yaw), the
+  driver is taken as still turned away, i.e. off road (zone: the last zone, `away` if that was
+  driving-related); otherwise where they look is unknown (zone None) and, after
+  `unavailable_s`, the driver is `driver_unavailable`.
+- `long_distraction`: the current off-road episode has spent `long_distraction_s` outside the
+  driving-related zones (`driving_related_zones`, the mirrors: their time pauses the timer, up to
+  `driving_glance_max_s` per continuous stay when that is set); level warning, raised to
   critical at `critical_distraction_s`.
-- `vats`: off-road time within the last `vats_window_s` reaches `vats_threshold_s`; fires once
-  and is re-armed after `vats_rearm_s` continuously on road.
+- `vats`: off-road time (every zone but road) within the last `vats_window_s` reaches
+  `vats_threshold_s`; fires once and is re-armed after `vats_rearm_s` continuously on road.
 - `cleared`: the first on-road sample with a face after any of the above.
 - speed gating: time off road or unavailable counts only while the vehicle moves faster than
   `min_speed_kmh` (`speed_kmh` None means unknown and is taken as moving), so no alert fires
@@ -31,115 +38,59 @@ first sample at or after its threshold, i.e. within one frame period of its defi
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 from roadgaze.config import MonitorConfig
+from roadgaze.monitor.state import (
+    EPS_S,
+    MonitorState,
+    distraction_s,
+    initial_state,
+    segment_distraction_s,
+    window_total,
+)
+from roadgaze.monitor.zones import AWAY, ROAD, ZoneMap
 from roadgaze.types import Alert, AlertKind, AlertLevel, Gaze, PoseSample, Verdict
 
-_EPS_S = 1e-6
-"""Durations are sums of float timestamps: compare them with this tolerance."""
+__all__ = ["Monitor", "MonitorState", "initial_state", "step", "verdict_of"]
+
 _MAX_LEARNING_STEP_S = 1.0
-"""A longer gap between samples teaches the neutral yaw no more than one second would."""
+"""A longer gap between samples teaches the neutral pose no more than one second would."""
+
+
+def _finite(smoothed: float | None, raw: float | None) -> float | None:
+    value = smoothed if smoothed is not None else raw
+    if value is None or not math.isfinite(value):
+        return None
+    return value
 
 
 @dataclass(frozen=True, slots=True)
-class MonitorState:
-    """Everything the monitor remembers between samples; replace, never mutate."""
+class _Look:
+    """Where the driver looks at one sample, as `_classify` judged it."""
 
-    neutral_yaw_deg: float
-    t_s: float | None = None
-    """Timestamp of the last sample taken into account."""
-    gaze: Gaze = Gaze.ON_ROAD
-    on_road: bool = True
-    """Hysteresis state of the head-pose classification (kept through face losses)."""
-    yaw_deg: float | None = None
-    last_face_yaw_deg: float | None = None
-    face_lost_since_s: float | None = None
-    face_lost_turned_away: bool = False
-    moving: bool = True
-    speed_kmh: float | None = None
-    off_since_s: float | None = None
-    """Start of the current counted (off road and moving) episode."""
-    long_level: AlertLevel | None = None
-    """Level already raised for the current episode."""
-    last_off_road_s: float = 0.0
-    """Duration of the most recent finished episode."""
-    off_intervals: tuple[tuple[float, float], ...] = ()
-    """Finished counted episodes [start, end) that still overlap the VATS window."""
-    vats_armed: bool = True
-    on_since_s: float | None = None
-    """Start of the current continuous on-road period (with a face)."""
-    unavailable_since_s: float | None = None
-    unavailable_alerted: bool = False
-    active: tuple[AlertKind, ...] = ()
-    """Alerts raised and not yet cleared, in the order they were raised."""
-    samples: int = 0
-    alert_counts: tuple[tuple[str, int], ...] = field(default=())
-
-    def off_road_s(self) -> float:
-        """Length of the current counted off-road episode at the last sample."""
-        if self.off_since_s is None or self.t_s is None:
-            return 0.0
-        return self.t_s - self.off_since_s
-
-    def window_off_road_s(self, window_s: float) -> float:
-        """Counted off-road time within `window_s` before the last sample."""
-        if self.t_s is None:
-            return 0.0
-        return _window_total(self.off_intervals, self.off_since_s, self.t_s, window_s)
-
-    def unavailable_s(self) -> float:
-        if self.unavailable_since_s is None or self.t_s is None:
-            return 0.0
-        return self.t_s - self.unavailable_since_s
-
-
-def initial_state(config: MonitorConfig) -> MonitorState:
-    """The state before the first sample: on road, neutral at the configured value or 0."""
-    neutral = 0.0 if config.neutral_yaw_deg is None else config.neutral_yaw_deg
-    return MonitorState(neutral_yaw_deg=neutral)
-
-
-def _window_total(
-    intervals: tuple[tuple[float, float], ...],
-    open_since_s: float | None,
-    t_s: float,
-    window_s: float,
-) -> float:
-    start_s = t_s - window_s
-    total = sum(max(0.0, min(end, t_s) - max(begin, start_s)) for begin, end in intervals)
-    if open_since_s is not None:
-        total += max(0.0, t_s - max(open_since_s, start_s))
-    return total
-
-
-def _sample_yaw(sample: PoseSample) -> float | None:
-    yaw = sample.yaw_deg if sample.yaw_deg is not None else sample.yaw_raw_deg
-    if yaw is None or not math.isfinite(yaw):
-        return None
-    return yaw
+    gaze: Gaze
+    zone: str | None
+    face_zone: str
+    yaw_deg: float | None
+    pitch_deg: float | None
+    lost_since_s: float | None
+    turned_away: bool
 
 
 def _classify(
-    config: MonitorConfig, state: MonitorState, sample: PoseSample, t_s: float
-) -> tuple[Gaze, bool, float | None, float | None, bool]:
-    """Gaze, hysteresis flag, yaw, face-lost start and turned-away flag for this sample."""
-    yaw = _sample_yaw(sample) if sample.face else None
+    config: MonitorConfig, zones: ZoneMap, state: MonitorState, sample: PoseSample, t_s: float
+) -> _Look:
+    yaw = _finite(sample.yaw_deg, sample.yaw_raw_deg) if sample.face else None
+    pitch = _finite(sample.pitch_deg, sample.pitch_raw_deg) if sample.face else None
     if sample.face:
         if yaw is None:  # a face whose yaw the model cannot explain: keep the last decision
-            return (
-                Gaze.ON_ROAD if state.on_road else Gaze.OFF_ROAD,
-                state.on_road,
-                None,
-                None,
-                False,
-            )
-        offset = abs(yaw - state.neutral_yaw_deg)
-        if state.on_road:
-            on_road = offset <= config.road_half_width_deg
+            zone = state.face_zone
         else:
-            on_road = offset <= config.road_half_width_deg - config.hysteresis_deg
-        return (Gaze.ON_ROAD if on_road else Gaze.OFF_ROAD), on_road, yaw, None, False
+            pitch_offset = 0.0 if pitch is None else pitch - state.neutral_pitch_deg
+            zone = zones.classify(yaw - state.neutral_yaw_deg, pitch_offset, state.face_zone)
+        gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
+        return _Look(gaze, zone, zone, yaw, pitch, None, False)
     if state.face_lost_since_s is not None:
         lost_since, turned = state.face_lost_since_s, state.face_lost_turned_away
     else:
@@ -148,21 +99,49 @@ def _classify(
             turned = not state.on_road
         else:
             turned = abs(state.last_face_yaw_deg - state.neutral_yaw_deg) > config.turn_away_deg
-    gaze = Gaze.OFF_ROAD if turned else Gaze.UNKNOWN
-    return gaze, (False if turned else state.on_road), None, lost_since, turned
+    if not turned:
+        return _Look(Gaze.UNKNOWN, None, state.face_zone, None, None, lost_since, False)
+    zone = state.face_zone
+    if zone == ROAD or zones.is_driving_related(zone):  # out of view: no longer a mirror glance
+        zone = AWAY
+    return _Look(Gaze.OFF_ROAD, zone, zone, None, None, lost_since, True)
+
+
+def _learn(value: float, neutral: float, gain: float, limit: float) -> float:
+    return max(-limit, min(limit, neutral + gain * (value - neutral)))
 
 
 def _learn_neutral(
-    config: MonitorConfig, state: MonitorState, yaw: float | None, gaze: Gaze, t_s: float
-) -> float:
-    if config.neutral_yaw_deg is not None or yaw is None or gaze is not Gaze.ON_ROAD:
-        return state.neutral_yaw_deg
-    if state.t_s is None:
-        return state.neutral_yaw_deg
+    config: MonitorConfig, state: MonitorState, look: _Look, t_s: float
+) -> tuple[float, float, float, float]:
+    """The neutral yaw and pitch after this sample and the time each has learned from.
+
+    A sample teaches when the head looks roughly ahead: its yaw within `road_half_width_deg` of
+    the neutral yaw and its pitch within +-`neutral_pitch_limit_deg` (where a neutral pitch may
+    lie). This is wider than the road zone, so a camera above or below the line of sight, whose
+    road pose reads outside the road zone at first, is still learned. The gain is the larger of
+    the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
+    over the time learned so far): the neutral settles on the driver's road pose within seconds
+    of the start and then follows it slowly.
+    """
+    yaw, pitch = state.neutral_yaw_deg, state.neutral_pitch_deg
+    yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s
+    if look.yaw_deg is None or state.t_s is None:
+        return yaw, pitch, yaw_s, pitch_s
+    ahead = abs(look.yaw_deg - yaw) <= config.road_half_width_deg
+    level = look.pitch_deg is None or abs(look.pitch_deg) <= config.neutral_pitch_limit_deg
+    if not (ahead and level):
+        return yaw, pitch, yaw_s, pitch_s
     dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
-    gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)
-    neutral = state.neutral_yaw_deg + gain * (yaw - state.neutral_yaw_deg)
-    return max(-config.neutral_limit_deg, min(config.neutral_limit_deg, neutral))
+    slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)
+    if config.neutral_yaw_deg is None:
+        gain = max(slow_gain, dt_s / (yaw_s + dt_s))
+        yaw, yaw_s = _learn(look.yaw_deg, yaw, gain, config.neutral_limit_deg), yaw_s + dt_s
+    if config.neutral_pitch_deg is None and look.pitch_deg is not None:
+        gain = max(slow_gain, dt_s / (pitch_s + dt_s))
+        pitch = _learn(look.pitch_deg, pitch, gain, config.neutral_pitch_limit_deg)
+        pitch_s += dt_s
+    return yaw, pitch, yaw_s, pitch_s
 
 
 def _count(counts: tuple[tuple[str, int], ...], alerts: list[Alert]) -> tuple[tuple[str, int], ...]:
@@ -176,35 +155,55 @@ def _count(counts: tuple[tuple[str, int], ...], alerts: list[Alert]) -> tuple[tu
 
 
 def step(
-    config: MonitorConfig, state: MonitorState, sample: PoseSample, speed_kmh: float | None
+    config: MonitorConfig,
+    state: MonitorState,
+    sample: PoseSample,
+    speed_kmh: float | None,
+    zones: ZoneMap | None = None,
 ) -> tuple[MonitorState, tuple[Alert, ...]]:
     """Advance the monitor by one sample; returns the new state and the alerts it raised.
 
     `speed_kmh` None means no speed is known and the vehicle is taken as moving. A sample whose
-    `t_s` is not after the previous one is ignored (the state is returned unchanged).
+    `t_s` is not after the previous one is ignored (the state is returned unchanged). `zones`
+    defaults to `config.zone_map()` (pass it to avoid rebuilding it every sample).
     """
     t_s = sample.t_s
     if not math.isfinite(t_s) or (state.t_s is not None and t_s <= state.t_s):
         return state, ()
-    gaze, on_road, yaw, lost_since, turned = _classify(config, state, sample, t_s)
+    zones = zones if zones is not None else config.zone_map()
+    look = _classify(config, zones, state, sample, t_s)
+    gaze, yaw = look.gaze, look.yaw_deg
     moving = speed_kmh is None or speed_kmh > config.min_speed_kmh
     alerts: list[Alert] = []
 
-    # Continuous off-road episode and the VATS window (counted only while moving).
+    # Continuous off-road episode, its distraction time and the VATS window (while moving).
     counted_off = gaze is Gaze.OFF_ROAD and moving
+    driving = zones.is_driving_related(look.zone)
     off_since = state.off_since_s
+    segment_since, segment_driving = state.segment_since_s, state.segment_driving
+    distraction_before = state.distraction_before_s
     intervals = state.off_intervals
     long_level = state.long_level
     last_off_road_s = state.last_off_road_s
     if counted_off and off_since is None:
-        off_since = t_s
+        off_since = segment_since = t_s
+        segment_driving, distraction_before = driving, 0.0
+    elif counted_off and driving != segment_driving:
+        distraction_before += segment_distraction_s(config, segment_since, t_s, segment_driving)
+        segment_since, segment_driving = t_s, driving
     elif not counted_off and off_since is not None:
         intervals = (*intervals, (off_since, t_s))
         last_off_road_s = t_s - off_since
-        off_since, long_level = None, None
+        off_since = segment_since = None
+        segment_driving, distraction_before, long_level = False, 0.0, None
     intervals = tuple(iv for iv in intervals if iv[1] > t_s - config.vats_window_s)
     off_road_s = 0.0 if off_since is None else t_s - off_since
-    window_s = _window_total(intervals, off_since, t_s, config.vats_window_s)
+    distraction_now_s = (
+        0.0
+        if off_since is None
+        else distraction_before + segment_distraction_s(config, segment_since, t_s, segment_driving)
+    )
+    window_s = window_total(intervals, off_since, t_s, config.vats_window_s)
 
     # Unavailable: no face, not turned away, while moving.
     unknown = gaze is Gaze.UNKNOWN and moving
@@ -234,12 +233,12 @@ def step(
     active = list(state.active)
     if counted_off:
         if (
-            off_road_s >= config.critical_distraction_s - _EPS_S
+            distraction_now_s >= config.critical_distraction_s - EPS_S
             and long_level is not AlertLevel.CRITICAL
         ):
             alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.CRITICAL))
             long_level = AlertLevel.CRITICAL
-        elif off_road_s >= config.long_distraction_s - _EPS_S and long_level is None:
+        elif distraction_now_s >= config.long_distraction_s - EPS_S and long_level is None:
             alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING))
             long_level = AlertLevel.WARNING
 
@@ -248,7 +247,7 @@ def step(
     on_with_face = gaze is Gaze.ON_ROAD and sample.face
     if on_with_face:
         on_since = t_s if on_since is None else on_since
-        if not vats_armed and t_s - on_since >= config.vats_rearm_s - _EPS_S:
+        if not vats_armed and t_s - on_since >= config.vats_rearm_s - EPS_S:
             vats_armed = True
     else:
         on_since = None
@@ -256,11 +255,11 @@ def step(
     # sample that ends it, i.e. when the driver looks back; it is cleared at the next one.
     just_ended = state.off_since_s is not None and off_since is None
     vats_due = counted_off or (just_ended and moving)
-    if vats_due and vats_armed and window_s >= config.vats_threshold_s - _EPS_S:
+    if vats_due and vats_armed and window_s >= config.vats_threshold_s - EPS_S:
         alerts.append(alert(AlertKind.VATS, AlertLevel.WARNING))
         vats_armed = False
 
-    if unknown and not unavailable_alerted and unavailable_s >= config.unavailable_s - _EPS_S:
+    if unknown and not unavailable_alerted and unavailable_s >= config.unavailable_s - EPS_S:
         alerts.append(alert(AlertKind.DRIVER_UNAVAILABLE, AlertLevel.WARNING))
         unavailable_alerted = True
 
@@ -271,19 +270,30 @@ def step(
         if raised.kind is not AlertKind.CLEARED and raised.kind not in active:
             active.append(raised.kind)
 
+    neutral_yaw, neutral_pitch, yaw_learned_s, pitch_learned_s = _learn_neutral(
+        config, state, look, t_s
+    )
     new_state = replace(
         state,
-        neutral_yaw_deg=_learn_neutral(config, state, yaw, gaze, t_s),
+        neutral_yaw_deg=neutral_yaw,
+        neutral_pitch_deg=neutral_pitch,
+        neutral_yaw_learned_s=yaw_learned_s,
+        neutral_pitch_learned_s=pitch_learned_s,
         t_s=t_s,
         gaze=gaze,
-        on_road=on_road,
+        zone=look.zone,
+        face_zone=look.face_zone,
         yaw_deg=yaw,
+        pitch_deg=look.pitch_deg,
         last_face_yaw_deg=yaw if yaw is not None else state.last_face_yaw_deg,
-        face_lost_since_s=lost_since,
-        face_lost_turned_away=turned,
+        face_lost_since_s=look.lost_since_s,
+        face_lost_turned_away=look.turned_away,
         moving=moving,
         speed_kmh=speed_kmh,
         off_since_s=off_since,
+        segment_since_s=segment_since,
+        segment_driving=segment_driving,
+        distraction_before_s=distraction_before,
         long_level=long_level,
         last_off_road_s=last_off_road_s,
         off_intervals=intervals,
@@ -302,7 +312,7 @@ def verdict_of(config: MonitorConfig, state: MonitorState) -> Verdict:
     """The monitor's view after the last sample, as the frame record carries it."""
     return Verdict(
         gaze=state.gaze,
-        on_road=None if state.gaze is Gaze.UNKNOWN else state.on_road,
+        on_road=None if state.gaze is Gaze.UNKNOWN else state.zone == ROAD,
         yaw_deg=state.yaw_deg,
         neutral_yaw_deg=state.neutral_yaw_deg,
         off_road_s=state.off_road_s(),
@@ -313,6 +323,10 @@ def verdict_of(config: MonitorConfig, state: MonitorState) -> Verdict:
         speed_kmh=state.speed_kmh,
         active=state.active,
         alert_counts=state.alert_counts,
+        zone=state.zone,
+        pitch_deg=state.pitch_deg,
+        neutral_pitch_deg=state.neutral_pitch_deg,
+        distraction_s=distraction_s(config, state),
     )
 
 
@@ -321,11 +335,12 @@ class Monitor:
 
     def __init__(self, config: MonitorConfig, state: MonitorState | None = None) -> None:
         self.config = config
+        self.zones = config.zone_map()
         self.state = initial_state(config) if state is None else state
 
     def update(self, sample: PoseSample, speed_kmh: float | None = None) -> tuple[Alert, ...]:
         """Advance by one sample; returns the alerts it raised (the verdict is `verdict`)."""
-        self.state, alerts = step(self.config, self.state, sample, speed_kmh)
+        self.state, alerts = step(self.config, self.state, sample, speed_kmh, self.zones)
         return alerts
 
     @property

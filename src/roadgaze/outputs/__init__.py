@@ -1,9 +1,11 @@
 """Outputs: the flat per-frame record and its writers (JSONL, CSV), the plot and annotated video."""
 
 from roadgaze.outputs.annotate import AnnotatedVideoWriter, annotate, verdict_text
+from roadgaze.outputs.offline import fill_offline_columns
 from roadgaze.outputs.plots import YawPlot
 from roadgaze.outputs.progress import ProgressBar
 from roadgaze.outputs.records import (
+    OFFLINE_FIELDS,
     RECORD_FIELDS,
     CsvWriter,
     JsonlWriter,
@@ -15,6 +17,7 @@ from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
 
 __all__ = [
     "FOURCC_BY_SUFFIX",
+    "OFFLINE_FIELDS",
     "RECORD_FIELDS",
     "AnnotatedVideoWriter",
     "CsvWriter",
@@ -22,6 +25,7 @@ __all__ = [
     "ProgressBar",
     "YawPlot",
     "annotate",
+    "fill_offline_columns",
     "open_for_writing",
     "open_video_writer",
     "record_fields",

@@ -53,9 +53,9 @@ class AnnotatedVideoWriter(ClosesOnExit):
 
 
 def verdict_text(record: FrameRecord) -> str:
-    """One line: the gaze, the off-road times and the alerts raised on this frame."""
+    """One line: the zone (or gaze), the off-road times and the alerts raised on this frame."""
     verdict = record.verdict
-    text = f"gaze {verdict.gaze.value}"
+    text = f"gaze {verdict.gaze.value}" if verdict.zone is None else f"zone {verdict.zone}"
     if round(verdict.off_road_s, 3):
         text += f"  off road {verdict.off_road_s:.1f} s"
     text += f"  in window {verdict.window_off_road_s:.1f} s"
@@ -169,9 +169,9 @@ def _yaw_text(sample: PoseSample) -> str:
         return "--" if value is None else f"{value:+.1f}{unit}"
 
     return (
-        f"yaw {number(sample.yaw_deg, '')} (raw {number(sample.yaw_raw_deg, '')}) deg  "
-        f"rate {number(sample.yaw_rate_dps, '')} dps  "
-        f"sd {'--' if sample.yaw_std_deg is None else f'{sample.yaw_std_deg:.1f}'}"
+        f"yaw {number(sample.yaw_deg, '')} (raw {number(sample.yaw_raw_deg, '')})  "
+        f"pitch {number(sample.pitch_deg, '')}  roll {number(sample.roll_deg, '')} deg  "
+        f"rate {number(sample.yaw_rate_dps, '')} dps"
     )
 
 

@@ -1,4 +1,4 @@
-"""The yaw plot: raw and smoothed yaw over time, with the truth and the alerts when known."""
+"""The pose plot: raw and smoothed yaw (and pitch) over time, with the truth and alerts if known."""
 
 from __future__ import annotations
 
@@ -14,11 +14,12 @@ ALERT_COLOURS = {"warning": "tab:orange", "critical": "tab:red", "info": "tab:gr
 
 
 class YawPlot(ClosesOnExit):
-    """Pipeline sink that collects the yaw of every record and saves a PNG when closed.
+    """Pipeline sink that collects the pose of every record and saves a PNG when closed.
 
     Drawn: raw yaw (points), smoothed yaw with its +-2 sigma band, each alert as a dashed line
-    with its kind; with `truth` (rows `t_s, yaw_deg, ...`) the true yaw too, and with
-    `road_half_width_deg` the road-ahead band around 0.
+    with its kind; with `truth` (rows `t_s, yaw_deg, pitch_deg`) the true yaw too, and with
+    `road_half_width_deg` the road-ahead band around 0. A second panel shows raw and smoothed
+    pitch (and the true pitch) when any record has a pitch.
     """
 
     def __init__(
@@ -36,6 +37,8 @@ class YawPlot(ClosesOnExit):
         self.raw_deg: list[float] = []
         self.smoothed_deg: list[float] = []
         self.std_deg: list[float] = []
+        self.pitch_raw_deg: list[float] = []
+        self.pitch_deg: list[float] = []
         self.alerts: list[Alert] = []
         self._closed = False
 
@@ -45,6 +48,8 @@ class YawPlot(ClosesOnExit):
         self.raw_deg.append(_nan_for_none(sample.yaw_raw_deg))
         self.smoothed_deg.append(_nan_for_none(sample.yaw_deg))
         self.std_deg.append(_nan_for_none(sample.yaw_std_deg))
+        self.pitch_raw_deg.append(_nan_for_none(sample.pitch_raw_deg))
+        self.pitch_deg.append(_nan_for_none(sample.pitch_deg))
         self.alerts.extend(record.alerts)
 
     def close(self) -> None:
@@ -59,7 +64,13 @@ class YawPlot(ClosesOnExit):
         t_s = np.asarray(self.t_s)
         smoothed = np.asarray(self.smoothed_deg)
         std = np.asarray(self.std_deg)
-        figure, axes = plt.subplots(figsize=(10, 4.5), dpi=110)
+        with_pitch = bool(np.any(np.isfinite(self.pitch_raw_deg)))
+        if with_pitch:
+            figure, (axes, pitch_axes) = plt.subplots(
+                2, 1, figsize=(10, 7), dpi=110, sharex=True, height_ratios=(3, 2)
+            )
+        else:
+            figure, axes = plt.subplots(figsize=(10, 4.5), dpi=110)
         if self.road_half_width_deg is not None:
             half = self.road_half_width_deg
             axes.axhspan(-half, half, color="tab:green", alpha=0.08, label="road ahead")
@@ -77,11 +88,26 @@ class YawPlot(ClosesOnExit):
                 alert.t_s, top, f" {alert.kind.value}", rotation=90, va="top", fontsize=7,
                 color=colour,
             )  # fmt: skip
-        axes.set_xlabel("time (s)")
         axes.set_ylabel("yaw (deg, + = driver's left)")
-        axes.set_title(self.title or "head yaw")
+        axes.set_title(self.title or "head pose")
         axes.legend(loc="lower left", fontsize=8)
         axes.grid(alpha=0.3)
+        if with_pitch:
+            if self.truth is not None and self.truth.shape[1] > 2:
+                pitch_axes.plot(
+                    self.truth[:, 0], self.truth[:, 2], "-", color="black", lw=1.2, label="truth"
+                )
+            pitch_axes.plot(
+                t_s, self.pitch_raw_deg, ".", markersize=3, color="tab:gray", label="raw"
+            )
+            pitch_axes.plot(t_s, self.pitch_deg, "-", color="tab:purple", label="smoothed")
+            pitch_axes.axhline(0.0, color="black", linewidth=0.5)
+            pitch_axes.set_ylabel("pitch (deg, + = up)")
+            pitch_axes.legend(loc="lower left", fontsize=8)
+            pitch_axes.grid(alpha=0.3)
+            pitch_axes.set_xlabel("time (s)")
+        else:
+            axes.set_xlabel("time (s)")
         figure.tight_layout()
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)

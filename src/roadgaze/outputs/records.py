@@ -25,6 +25,8 @@ RECORD_FIELDS = (
     "yaw_deg",
     "yaw_rate_dps",
     "yaw_std_deg",
+    "pitch_raw_deg",
+    "pitch_deg",
     "x_left",
     "x_right",
     "x_center",
@@ -32,12 +34,22 @@ RECORD_FIELDS = (
     "quality",
     "on_road",
     "gaze",
+    "zone",
+    "eyes_on_road",
     "neutral_yaw_deg",
+    "neutral_pitch_deg",
     "off_road_s",
     "window_off_road_s",
+    "distraction_s",
     "alerts",
+    "yaw_offline_deg",
+    "pitch_offline_deg",
 )
-"""The fields of `record_fields`, in order (x_* in pixels of the roll-removed frame)."""
+"""The fields of `record_fields`, in order (x_* in pixels of the roll-removed frame).
+`yaw_offline_deg` / `pitch_offline_deg` are null while a replay streams; `fill_offline_columns`
+fills them at its end."""
+
+OFFLINE_FIELDS = ("yaw_offline_deg", "pitch_offline_deg")
 
 
 def rounded(value: float | None, digits: int) -> float | None:
@@ -60,17 +72,25 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "yaw_deg": rounded(sample.yaw_deg, 3),
         "yaw_rate_dps": rounded(sample.yaw_rate_dps, 3),
         "yaw_std_deg": rounded(sample.yaw_std_deg, 3),
+        "pitch_raw_deg": rounded(sample.pitch_raw_deg, 3),
+        "pitch_deg": rounded(sample.pitch_deg, 3),
         "x_left": None if features is None else rounded(features.x_left_px, 2),
         "x_right": None if features is None else rounded(features.x_right_px, 2),
         "x_center": None if features is None else rounded(features.x_center_px, 2),
-        "roll_deg": None if features is None else rounded(features.roll_deg, 2),
+        "roll_deg": rounded(sample.roll_deg, 2),
         "quality": None if features is None else rounded(features.quality, 3),
         "on_road": verdict.on_road,
         "gaze": verdict.gaze.value,
+        "zone": verdict.zone,
+        "eyes_on_road": verdict.on_road,
         "neutral_yaw_deg": round(verdict.neutral_yaw_deg, 3),
+        "neutral_pitch_deg": round(verdict.neutral_pitch_deg, 3),
         "off_road_s": round(verdict.off_road_s, 3),
         "window_off_road_s": round(verdict.window_off_road_s, 3),
+        "distraction_s": round(verdict.distraction_s, 3),
         "alerts": [alert.label for alert in record.alerts],
+        "yaw_offline_deg": None,
+        "pitch_offline_deg": None,
     }
 
 

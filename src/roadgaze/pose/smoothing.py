@@ -1,24 +1,93 @@
-"""Kalman smoother of head yaw: constant-velocity model over filterpy's `KalmanFilter`.
+"""The online (causal) smoother of one head angle: a Kalman filter that never makes things worse.
 
-State `[yaw_deg, yaw_rate_dps]`; `dt` comes from the samples' timestamps, so dropped frames and
-irregular rates are handled. Without a face the filter only predicts (its variance grows); after
-`reinit_gap_s` without an accepted measurement the track is dropped and restarts on the next
-face. A measurement whose innovation exceeds `gate_sigma` standard deviations is rejected as an
-outlier; `max_rejections` consecutive rejections mean the head really moved, and the track is
-re-initialised on the new measurement. Noise levels come from `SmoothingConfig`.
+Constant-velocity model over filterpy's `KalmanFilter`, state `[angle_deg, rate_dps]`, `dt` from
+the samples' timestamps; the pose stage runs one per angle (yaw, pitch). Four rules keep it from
+doing harm where the raw series is already good (docs/pose.md has the measurements):
+
+1. **Measured noise.** The measurement noise R is the robust (median absolute) spread of the raw
+   series' linear-extrapolation residuals over the last `noise_window` frames (floor
+   `min_measurement_std_deg`; `measurement_std_deg` until `min_noise_samples` residuals exist).
+   A clean series passes through almost untouched, a noisy one is smoothed as its noise justifies.
+2. **Bounded output.** The estimate is clamped to the range of the accepted raw values of the last
+   `clamp_window_s`, and the clamp is written back into the state: the constant-velocity model's
+   overshoot and ringing after a step cannot leave the raw range.
+3. **No extrapolation through gaps.** Without a measurement the estimate holds (rate set to 0; the
+   variance still grows, so the next measurement is trusted); after `reinit_gap_s` the track is
+   dropped and restarts on the next measurement.
+4. **Outlier gate.** A measurement further than `gate_sigma` standard deviations of the
+   innovation from the prediction, the measurement noise taken as at least `measurement_std_deg`,
+   is rejected (the prediction, kept within the raw range, stands in for it); `max_rejections`
+   consecutive rejections mean the head really moved, and the track restarts on the measurement.
+   A single-frame jump of tens of degrees is gated out; a head turn passes (its deviation from a
+   constant rate within one frame is a few degrees).
 """
 
 from __future__ import annotations
 
 import math
+import statistics
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
-from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
 from roadgaze.config import SmoothingConfig
-from roadgaze.types import SmoothedYaw
+from roadgaze.types import FloatArray, SmoothedAngle
+
+__all__ = [
+    "MAD_TO_STD",
+    "AngleSmoother",
+    "SmootherState",
+    "constant_velocity_model",
+    "extrapolation_residuals",
+    "robust_noise_std_deg",
+]
+
+MAD_TO_STD = 1.4826
+"""Median absolute deviation to standard deviation, for Gaussian noise."""
+
+
+def extrapolation_residuals(t_s: FloatArray, values: FloatArray) -> FloatArray:
+    """Residuals of predicting each value linearly from the two before it, scaled so that their
+    standard deviation is that of white measurement noise; non-finite values are skipped.
+
+    For a constant frame rate the residual is the second difference, whose variance is 6 sigma^2.
+    """
+    t = np.asarray(t_s, dtype=np.float64)
+    z = np.asarray(values, dtype=np.float64)
+    usable = np.isfinite(z) & np.isfinite(t)
+    t, z = t[usable], z[usable]
+    if z.size < 3:
+        return np.zeros(0)
+    ratio = (t[2:] - t[1:-1]) / (t[1:-1] - t[:-2])
+    residual = z[2:] - z[1:-1] - (z[1:-1] - z[:-2]) * ratio
+    return np.asarray(residual / np.sqrt(1.0 + (1.0 + ratio) ** 2 + ratio**2), dtype=np.float64)
+
+
+def robust_noise_std_deg(t_s: FloatArray, values: FloatArray) -> float:
+    """White-noise standard deviation of a series from its extrapolation residuals (MAD), degrees;
+    NaN with fewer than three finite values. A smooth head turn barely moves it."""
+    residual = extrapolation_residuals(t_s, values)
+    if residual.size == 0:
+        return math.nan
+    return float(MAD_TO_STD * np.median(np.abs(residual)))
+
+
+def constant_velocity_model(
+    dt_s: float, acceleration_std_dps2: float
+) -> tuple[FloatArray, FloatArray]:
+    """Transition F and process noise Q of the constant-velocity model over `dt_s` seconds.
+
+    Q is filterpy's `Q_discrete_white_noise(dim=2, dt, var)` (piecewise white acceleration),
+    written out: var * [[dt^4/4, dt^3/2], [dt^3/2, dt^2]].
+    """
+    transition = np.array([[1.0, dt_s], [0.0, 1.0]])
+    var = acceleration_std_dps2**2
+    noise = var * np.array(
+        [[dt_s**4 / 4.0, dt_s**3 / 2.0], [dt_s**3 / 2.0, dt_s**2]], dtype=np.float64
+    )
+    return transition, noise
 
 
 @dataclass(frozen=True, slots=True)
@@ -26,44 +95,56 @@ class SmootherState:
     """A snapshot of the smoother's explicit state (for inspection, logging and tests)."""
 
     tracking: bool
-    """False before the first face and after the track was dropped."""
+    """False before the first measurement and after the track was dropped."""
     t_s: float | None
-    """Time of the last update or prediction."""
+    """Time of the last update."""
     last_measurement_t_s: float | None
     """Time of the last accepted (or re-initialising) measurement."""
-    yaw_deg: float | None
-    yaw_rate_dps: float | None
-    yaw_std_deg: float | None
+    angle_deg: float | None
+    rate_dps: float | None
+    std_deg: float | None
+    measurement_std_deg: float
+    """The measurement noise currently assumed (measured, or the configured value before that)."""
     consecutive_rejections: int
     """Measurements rejected by the gate since the last accepted one."""
     rejected_total: int
     reinitialisations: int
-    """Re-starts after a gap or after a run of rejections (the first start is not counted)."""
+    """Restarts after a gap or after a run of rejections (the first start is not counted)."""
 
 
-class YawSmoother:
-    """Smooths one stream of raw yaw measurements; call `update` once per frame, in time order."""
+class AngleSmoother:
+    """Smooths one stream of raw angle measurements (degrees); `update` once per frame, in order."""
 
     def __init__(self, config: SmoothingConfig | None = None) -> None:
         self.config = config if config is not None else SmoothingConfig()
         self._filter = KalmanFilter(dim_x=2, dim_z=1)
         self._filter.H = np.array([[1.0, 0.0]])
-        self._filter.R = np.array([[self.config.measurement_std_deg**2]])
         self._tracking = False
+        self._holding = False
+        self._started = False
         self._t_s: float | None = None
         self._last_measurement_t_s: float | None = None
+        self._recent: deque[tuple[float, float]] = deque()
+        """Accepted (t_s, value) within `clamp_window_s`: bounded by the frame rate."""
+        self._history: deque[tuple[float, float]] = deque(maxlen=3)
+        self._residuals: deque[float] = deque(maxlen=self.config.noise_window)
+        self._noise_std_deg = self.config.measurement_std_deg
         self._consecutive_rejections = 0
         self._rejected_total = 0
         self._reinitialisations = 0
-        self._started = False
         self._model_dt_s = math.nan
+        self._model: tuple[FloatArray, FloatArray] = (np.eye(2), np.zeros((2, 2)))
 
     def reset(self) -> None:
-        """Forget the track; the next measurement starts a new one."""
+        """Forget the track; the next measurement starts a new one (counters are kept)."""
         self._tracking = False
         self._t_s = None
         self._last_measurement_t_s = None
         self._consecutive_rejections = 0
+
+    def measurement_std_deg(self) -> float:
+        """The measurement noise assumed now: measured once enough residuals exist."""
+        return self._noise_std_deg
 
     @property
     def state(self) -> SmootherState:
@@ -72,30 +153,31 @@ class YawSmoother:
             tracking=self._tracking,
             t_s=self._t_s,
             last_measurement_t_s=self._last_measurement_t_s,
-            yaw_deg=None if estimate is None else estimate.yaw_deg,
-            yaw_rate_dps=None if estimate is None else estimate.yaw_rate_dps,
-            yaw_std_deg=None if estimate is None else estimate.yaw_std_deg,
+            angle_deg=None if estimate is None else estimate.angle_deg,
+            rate_dps=None if estimate is None else estimate.rate_dps,
+            std_deg=None if estimate is None else estimate.std_deg,
+            measurement_std_deg=self.measurement_std_deg(),
             consecutive_rejections=self._consecutive_rejections,
             rejected_total=self._rejected_total,
             reinitialisations=self._reinitialisations,
         )
 
-    def update(self, t_s: float, yaw_deg: float | None) -> SmoothedYaw | None:
-        """Advance to `t_s` and fold in `yaw_deg` (None: no face, predict only).
+    def update(self, t_s: float, value_deg: float | None) -> SmoothedAngle | None:
+        """Advance to `t_s` and fold in `value_deg` (None, NaN or infinite: no measurement).
 
-        Returns the estimate at `t_s`, or None when there is no track (before the first face, or
-        once `reinit_gap_s` has passed without a measurement). `t_s` must increase strictly while
-        a track is running; a NaN or infinite `yaw_deg` counts as no measurement.
+        Returns the estimate at `t_s`, or None without a track (before the first measurement, or
+        once `reinit_gap_s` has passed without one). Raises ValueError when `t_s` does not
+        increase while a track runs.
         """
-        if yaw_deg is not None and not math.isfinite(yaw_deg):
-            yaw_deg = None
+        if value_deg is not None and not math.isfinite(value_deg):
+            value_deg = None
         if not self._tracking:
-            if yaw_deg is None:
-                self._t_s = t_s
+            self._t_s = t_s
+            if value_deg is None:
                 return None
             if self._started:
                 self._reinitialisations += 1
-            self._start(t_s, yaw_deg)
+            self._start(t_s, value_deg)
             return self._estimate()
         assert self._t_s is not None and self._last_measurement_t_s is not None
         dt_s = t_s - self._t_s
@@ -104,55 +186,103 @@ class YawSmoother:
                 f"smoother timestamps must increase: got t_s={t_s} after t_s={self._t_s}"
             )
         if t_s - self._last_measurement_t_s > self.config.reinit_gap_s:
-            if yaw_deg is None:
+            self._t_s = t_s
+            if value_deg is None:
                 self._tracking = False
-                self._t_s = t_s
                 return None
             self._reinitialisations += 1
-            self._start(t_s, yaw_deg)
+            self._start(t_s, value_deg)
             return self._estimate()
-        self._predict(dt_s)
         self._t_s = t_s
-        if yaw_deg is None:
+        if value_deg is None:
+            self._hold(dt_s)
             return self._estimate()
-        innovation_deg = yaw_deg - float(self._filter.x[0, 0])
-        innovation_var = float(self._filter.P[0, 0]) + self.config.measurement_std_deg**2
-        if innovation_deg**2 > self.config.gate_sigma**2 * innovation_var:
+        if self._holding:  # re-acquired after a gap: the rate is unknown, restart it from 0
+            self._filter.x[1, 0] = 0.0
+            self._filter.P[0, 1] = self._filter.P[1, 0] = 0.0
+            self._filter.P[1, 1] = self.config.initial_rate_std_dps**2
+            self._history.clear()
+            self._holding = False
+        self._predict(dt_s)
+        if self._is_outlier(value_deg):
             self._rejected_total += 1
             self._consecutive_rejections += 1
             if self._consecutive_rejections >= self.config.max_rejections:
                 self._reinitialisations += 1
-                self._start(t_s, yaw_deg)
+                self._start(t_s, value_deg)
+            else:  # the prediction stands in for the rejected measurement, within the raw range
+                self._clamp(t_s, None)
             return self._estimate()
-        self._filter.update(np.array([[yaw_deg]]))
         self._consecutive_rejections = 0
+        self._learn_noise(t_s, value_deg)
+        noise_std = self.measurement_std_deg()
+        self._filter.update(np.array([[value_deg]]), R=np.array([[noise_std**2]]))
         self._last_measurement_t_s = t_s
+        self._clamp(t_s, value_deg)
         return self._estimate()
 
-    def _start(self, t_s: float, yaw_deg: float) -> None:
-        self._filter.x = np.array([[yaw_deg], [0.0]])
-        self._filter.P = np.diag(
-            [self.config.initial_std_deg**2, self.config.initial_rate_std_dps**2]
-        )
-        self._tracking = True
-        self._started = True
-        self._t_s = t_s
-        self._last_measurement_t_s = t_s
+    def _is_outlier(self, value_deg: float) -> bool:
+        """Whether the innovation exceeds the gate (after `_predict`)."""
+        gate_noise_std = max(self.measurement_std_deg(), self.config.measurement_std_deg)
+        innovation_var = float(self._filter.P[0, 0]) + gate_noise_std**2
+        innovation_deg = value_deg - float(self._filter.x[0, 0])
+        return innovation_deg**2 > self.config.gate_sigma**2 * innovation_var
+
+    def _start(self, t_s: float, value_deg: float) -> None:
+        config = self.config
+        self._filter.x = np.array([[value_deg], [0.0]])
+        self._filter.P = np.diag([config.initial_std_deg**2, config.initial_rate_std_dps**2])
+        self._tracking = self._started = True
+        self._holding = False
+        self._t_s = self._last_measurement_t_s = t_s
         self._consecutive_rejections = 0
+        self._recent.clear()
+        self._recent.append((t_s, value_deg))
+        self._history.clear()
+        self._learn_noise(t_s, value_deg)
 
     def _predict(self, dt_s: float) -> None:
-        if dt_s != self._model_dt_s:  # most streams repeat one dt: build F and Q once
+        if not abs(dt_s - self._model_dt_s) <= 1e-9:  # most streams repeat one dt: F, Q once
             self._model_dt_s = dt_s
-            self._filter.F = np.array([[1.0, dt_s], [0.0, 1.0]])
-            self._filter.Q = Q_discrete_white_noise(
-                dim=2, dt=dt_s, var=self.config.acceleration_std_dps2**2
-            )
-        self._filter.predict()
+            self._model = constant_velocity_model(dt_s, self.config.acceleration_std_dps2)
+        transition, noise = self._model
+        self._filter.predict(F=transition, Q=noise)
 
-    def _estimate(self) -> SmoothedYaw:
+    def _hold(self, dt_s: float) -> None:
+        """No usable measurement: keep the angle, drop the rate, let the variance grow."""
+        self._filter.x[1, 0] = 0.0
+        if dt_s > 0:
+            self._predict(dt_s)
+        self._holding = True
+
+    def _learn_noise(self, t_s: float, value_deg: float) -> None:
+        self._history.append((t_s, value_deg))
+        if len(self._history) < 3:
+            return
+        (t0, z0), (t1, z1), (t2, z2) = self._history
+        ratio = (t2 - t1) / (t1 - t0)
+        residual = z2 - z1 - (z1 - z0) * ratio  # as `extrapolation_residuals`, one at a time
+        self._residuals.append(residual / math.sqrt(1.0 + (1.0 + ratio) ** 2 + ratio**2))
+        config = self.config
+        if len(self._residuals) >= config.min_noise_samples:
+            spread = statistics.median(abs(r) for r in self._residuals)
+            self._noise_std_deg = max(MAD_TO_STD * spread, config.min_measurement_std_deg)
+
+    def _clamp(self, t_s: float, value_deg: float | None) -> None:
+        """Add an accepted value (None: none) and clamp the estimate to the recent raw range."""
+        recent = self._recent
+        if value_deg is not None:
+            recent.append((t_s, value_deg))
+        while len(recent) > 1 and recent[0][0] <= t_s - self.config.clamp_window_s:
+            recent.popleft()
+        low = min(value for _, value in recent)
+        high = max(value for _, value in recent)
+        self._filter.x[0, 0] = min(max(float(self._filter.x[0, 0]), low), high)
+
+    def _estimate(self) -> SmoothedAngle:
         x = self._filter.x
-        return SmoothedYaw(
-            yaw_deg=float(x[0, 0]),
-            yaw_rate_dps=float(x[1, 0]),
-            yaw_std_deg=math.sqrt(max(float(self._filter.P[0, 0]), 0.0)),
+        return SmoothedAngle(
+            angle_deg=float(x[0, 0]),
+            rate_dps=float(x[1, 0]),
+            std_deg=math.sqrt(max(float(self._filter.P[0, 0]), 0.0)),
         )

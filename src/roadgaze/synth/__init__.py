@@ -1,4 +1,4 @@
-"""Synthetic ground truth: one real photo's face mesh turned to known poses and re-rendered."""
+"""Synthetic ground truth: a real photo's face mesh turned to known poses, rendered, measured."""
 
 from roadgaze.synth.clip import (
     DEFAULT_FPS,
@@ -9,12 +9,25 @@ from roadgaze.synth.clip import (
     truth_path_for,
     write_truth_csv,
 )
+from roadgaze.synth.clip_measure import (
+    POSE_TIMELINE,
+    ChannelErrors,
+    ClipMeasurement,
+    format_clip_measurement,
+    measure_clip,
+)
 from roadgaze.synth.measure import (
+    PITCH_ESTIMATORS,
+    PITCH_RANGES_DEG,
     YAW_RANGES_DEG,
+    PitchRecovery,
     YawRecovery,
     format_measurement,
+    format_pitch_measurement,
+    measure_pitch_recovery,
     measure_yaw_recovery,
     write_measurement_csv,
+    zone_agreement,
 )
 from roadgaze.synth.renderer import (
     DEFAULT_SIZE,
@@ -42,16 +55,26 @@ __all__ = [
     "MAX_ABS_PITCH_DEG",
     "MAX_ABS_YAW_DEG",
     "MAX_CLIP_S",
+    "PITCH_ESTIMATORS",
+    "PITCH_RANGES_DEG",
+    "POSE_TIMELINE",
     "TRUTH_HEADER",
     "YAW_RANGES_DEG",
+    "ChannelErrors",
+    "ClipMeasurement",
     "FaceRenderer",
     "Keyframe",
     "PhotoMesh",
+    "PitchRecovery",
     "Timeline",
     "YawRecovery",
     "default_photo_path",
+    "format_clip_measurement",
     "format_measurement",
+    "format_pitch_measurement",
     "load_photo",
+    "measure_clip",
+    "measure_pitch_recovery",
     "measure_yaw_recovery",
     "mesh_triangles",
     "parse_timeline",
@@ -62,4 +85,5 @@ __all__ = [
     "truth_path_for",
     "write_measurement_csv",
     "write_truth_csv",
+    "zone_agreement",
 ]

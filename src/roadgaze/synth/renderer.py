@@ -1,7 +1,9 @@
 """Synthetic ground-truth clips: one real photo's face mesh turned to known yaws and re-rendered.
 
 Yaw > 0 turns the head to the person's own left (the nose moves to the image right), pitch > 0
-looks up, both relative to the photo's own head pose.
+looks up, both relative to the photo's own head pose; the head nods first and then turns, so the
+pitch is the elevation of the face's direction (the convention of Pointing'04 and of MediaPipe's
+matrix angles).
 
 Rendering: MediaPipe's 478-point face mesh of the photo is lifted to 3D with its own depth
 (landmark z, in pixels), rotated about a neck pivot behind the face and projected orthographically.
@@ -234,7 +236,9 @@ class FaceRenderer:
         return background
 
     def turned_points(self, yaw_deg: float, pitch_deg: float = 0.0) -> FloatArray:
-        """The mesh turned by yaw (about the vertical axis) then pitch, about the neck pivot."""
+        """The mesh nodded by pitch (about the head's lateral axis), then turned by yaw (about
+        the vertical axis), both about the neck pivot: pitch is the elevation of the face's
+        forward direction, as in Pointing'04's tilt and MediaPipe's matrix angles."""
         return turn_points(self.mesh.points_px, self.mesh.pivot_px, yaw_deg, pitch_deg)
 
     def render(self, yaw_deg: float, pitch_deg: float = 0.0) -> ImageBGR:
@@ -280,7 +284,8 @@ class FaceRenderer:
 def turn_points(
     points_px: FloatArray, pivot_px: FloatArray, yaw_deg: float, pitch_deg: float = 0.0
 ) -> FloatArray:
-    """(N, 3) points turned as the renderer turns the mesh: yaw, then pitch, about `pivot_px`."""
+    """(N, 3) points turned as the renderer turns the mesh, about `pivot_px`: nodded by pitch,
+    then turned by yaw (pitch is the elevation of the face's forward direction)."""
     yaw, pitch = math.radians(yaw_deg), math.radians(pitch_deg)
     # Image axes: x right, y down, z away from the camera. Positive yaw moves the nose (z < 0
     # relative to the pivot) to +x; positive pitch moves it up (-y).
@@ -299,7 +304,7 @@ def turn_points(
         ]
     )
     relative = np.asarray(points_px, dtype=np.float64) - pivot_px
-    return np.asarray(relative @ (rotate_pitch @ rotate_yaw).T + pivot_px)
+    return np.asarray(relative @ (rotate_yaw @ rotate_pitch).T + pivot_px)
 
 
 def push_pull_fill(

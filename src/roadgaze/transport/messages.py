@@ -14,9 +14,9 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from roadgaze.types import Alert, AlertKind, AlertLevel, FrameRecord, Gaze
 
-YAW_SCHEMA = "roadgaze.yaw/1"
+YAW_SCHEMA = "roadgaze.yaw/2"
 ALERT_SCHEMA = "roadgaze.alert/1"
-STATE_SCHEMA = "roadgaze.state/1"
+STATE_SCHEMA = "roadgaze.state/2"
 
 
 class _Message(BaseModel):
@@ -32,9 +32,13 @@ class _Message(BaseModel):
 
 
 class YawMessage(_Message):
-    """One frame's head yaw and road-ahead decision."""
+    """One frame's head pose (yaw, pitch, roll), glance zone and road-ahead decision.
 
-    schema_id: Literal["roadgaze.yaw/1"] = Field(default="roadgaze.yaw/1", alias="schema")
+    `roadgaze.yaw/2` extends `/1` with `pitch_deg`, `pitch_raw_deg`, `roll_deg`, `zone`,
+    `eyes_on_road` and `neutral_pitch_deg`; every `/1` field keeps its name and meaning.
+    """
+
+    schema_id: Literal["roadgaze.yaw/2"] = Field(default="roadgaze.yaw/2", alias="schema")
     vehicle_id: str
     seq: int = Field(ge=0, description="Per-key sequence number, from 0 at start.")
     t_s: float = Field(
@@ -50,6 +54,23 @@ class YawMessage(_Message):
     gaze: Gaze
     neutral_yaw_deg: float
     n_faces: int = Field(default=0, ge=0)
+    pitch_deg: float | None = Field(
+        default=None, description="Smoothed pitch, > 0 = looking up; null without a face."
+    )
+    pitch_raw_deg: float | None = None
+    roll_deg: float | None = Field(
+        default=None,
+        description="Eye-line roll, > 0 = counter-clockwise in the image (not validated).",
+    )
+    zone: str | None = Field(
+        default=None,
+        description="Glance zone: road, lap, cluster, centre_stack, left_mirror, right_mirror "
+        "(or another configured zone) or away; null when the gaze is unknown.",
+    )
+    eyes_on_road: bool | None = Field(
+        default=None, description="zone == 'road'; null when the gaze is unknown."
+    )
+    neutral_pitch_deg: float = 0.0
 
     @classmethod
     def from_record(
@@ -71,6 +92,12 @@ class YawMessage(_Message):
             gaze=verdict.gaze,
             neutral_yaw_deg=verdict.neutral_yaw_deg,
             n_faces=sample.n_faces,
+            pitch_deg=sample.pitch_deg,
+            pitch_raw_deg=sample.pitch_raw_deg,
+            roll_deg=sample.roll_deg,
+            zone=verdict.zone,
+            eyes_on_road=verdict.on_road,
+            neutral_pitch_deg=verdict.neutral_pitch_deg,
         )
 
 
@@ -133,6 +160,9 @@ class MonitorSnapshot(_Message):
     on_road: bool
     neutral_yaw_deg: float
     yaw_deg: float | None
+    zone: str | None = None
+    neutral_pitch_deg: float = 0.0
+    pitch_deg: float | None = None
     off_road_s: float
     window_off_road_s: float
     unavailable_s: float
@@ -145,9 +175,12 @@ class MonitorSnapshot(_Message):
 
 
 class StateMessage(_Message):
-    """Answer of the `state` queryable: health, monitor state, counters and config summary."""
+    """Answer of the `state` queryable: health, monitor state, counters and config summary.
 
-    schema_id: Literal["roadgaze.state/1"] = Field(default="roadgaze.state/1", alias="schema")
+    `roadgaze.state/2` adds `zone`, `pitch_deg` and `neutral_pitch_deg` to `monitor`.
+    """
+
+    schema_id: Literal["roadgaze.state/2"] = Field(default="roadgaze.state/2", alias="schema")
     vehicle_id: str
     wall_time: float
     status: Literal["starting", "running", "degraded", "stopping", "stopped"]

@@ -21,6 +21,8 @@ PURE_MODULES = (
     "roadgaze.monitor",
     "roadgaze.monitor.eyes",
     "roadgaze.monitor.eye_rules",
+    "roadgaze.monitor.escalation",
+    "roadgaze.monitor.neutral",
     "roadgaze.transport.messages",
     "roadgaze.transport.keys",
     "roadgaze.transport.speed",

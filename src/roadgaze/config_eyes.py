@@ -57,6 +57,10 @@ class EyeMonitorSettings(BaseModel):
     as looking down, not as closed."""
     gaze_deadband_deg: float = Field(default=10.0, ge=0)
     """Eye-in-head deviations from the driver's resting eye direction below this count as none."""
+    eyes_road_margin_deg: float = Field(default=5.0, ge=0)
+    """With the eyes measured, the road zone is narrower by this in yaw (both sides) and at its
+    lower edge, so an eyes-only glance beyond 30 deg sideways or 20 deg down leaves it despite
+    the deadband (with the default road)."""
     eye_neutral_limit_deg: float = Field(default=15.0, ge=0)
     microsleep_s: float = Field(default=1.0, gt=0)
     sleep_s: float = Field(default=3.0, gt=0)

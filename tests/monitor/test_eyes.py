@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from fakes import eyes_of
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.eye_rules import classify_eyes, gaze_deg, soft_threshold
 from roadgaze.monitor.eyes import EyeMonitorState, clearable_eye_kinds, step_eyes
@@ -20,41 +21,6 @@ from roadgaze.types import (
 
 CONFIG = MonitorConfig()
 FPS = 15.0
-
-
-def eyes_of(
-    openness: float = 0.30,
-    blink: float | None = None,
-    eye_yaw: float = 0.0,
-    eye_pitch: float = 0.0,
-    usable: bool = True,
-    occluded: bool = False,
-) -> EyesFeatures:
-    if blink is None:
-        blink = 0.6 if openness < 0.14 else 0.05
-
-    def one(side: str) -> EyeMeasurement:
-        return EyeMeasurement(
-            side=side,
-            width_px=30.0,
-            openness=openness,
-            gaze_usable=usable and not occluded,
-            closure_usable=usable and not occluded,
-            reason="" if usable else "head turned",
-            yaw_deg=eye_yaw if usable else None,
-            pitch_deg=eye_pitch if usable else None,
-            blink=blink,
-            look_down=0.0,
-        )
-
-    return EyesFeatures(
-        right=one("right"),
-        left=one("left"),
-        method="blendshapes",
-        scale_px=30.0,
-        reason="" if usable else "head turned",
-        occluded=occluded,
-    )
 
 
 def face(mp_pitch_deg: float = 0.0) -> FaceFeatures:

@@ -8,9 +8,10 @@ from __future__ import annotations
 import math
 
 from roadgaze.config import MonitorConfig
+from roadgaze.monitor.zones import Zone, ZoneMap
 from roadgaze.types import EyesFeatures, EyeStatus
 
-__all__ = ["POPULATION_OPEN", "classify_eyes", "gaze_deg", "soft_threshold"]
+__all__ = ["POPULATION_OPEN", "classify_eyes", "eye_zone_map", "gaze_deg", "soft_threshold"]
 
 POPULATION_OPEN = 0.30
 """The open-eye openness the thresholds are set for (Pointing'04 median 0.31)."""
@@ -77,3 +78,19 @@ def classify_eyes(
     if head_below_road_deg is not None and head_below_road_deg > config.look_down_head_deg:
         return EyeStatus.OPEN, "looking down"
     return EyeStatus.CLOSED, "eyes closed"
+
+
+def eye_zone_map(zones: ZoneMap, margin_deg: float) -> ZoneMap:
+    """The zones for a gaze measured with the eyes: the road (the first zone) narrower by
+    `margin_deg` on both sides in yaw and at its lower edge (never inverted); the upper edge and
+    the other zones as they are (MediaPipe's eye pitch does not register upward gaze)."""
+    road = zones.zones[0]
+    yaw_half = max(0.0, 0.5 * (road.yaw_max_deg - road.yaw_min_deg) - margin_deg)
+    yaw_mid = 0.5 * (road.yaw_max_deg + road.yaw_min_deg)
+    pitch_min = min(road.pitch_min_deg + margin_deg, road.pitch_max_deg)
+    narrow = Zone(road.name, yaw_mid - yaw_half, yaw_mid + yaw_half, pitch_min, road.pitch_max_deg)
+    return ZoneMap(
+        zones=(narrow, *zones.zones[1:]),
+        hysteresis_deg=zones.hysteresis_deg,
+        driving_related=zones.driving_related,
+    )

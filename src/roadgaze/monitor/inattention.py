@@ -98,6 +98,16 @@ class _Look:
     turned_away: bool
 
 
+def _eyes_moved(eyes: EyesVerdict, head_yaw_deg: float, head_pitch_deg: float) -> bool:
+    """The eyes give the gaze and have moved beyond the deadband (gaze != head pose)."""
+    return (
+        eyes.gaze_source == "eyes"
+        and eyes.gaze_yaw_deg is not None
+        and eyes.gaze_pitch_deg is not None
+        and (eyes.gaze_yaw_deg != head_yaw_deg or eyes.gaze_pitch_deg != head_pitch_deg)
+    )
+
+
 def _classify(
     config: MonitorConfig,
     zones: ZoneMap,
@@ -111,14 +121,13 @@ def _classify(
     if sample.face:
         if yaw is None:  # a face whose yaw the model cannot explain: keep the last decision
             zone = state.face_zone
-        elif eyes.gaze_source == "eyes" and eyes.gaze_yaw_deg is not None:
+        elif _eyes_moved(
+            eyes, yaw, state.neutral_pitch_deg if pitch is None else pitch
+        ):  # an eye glance: judged on the gaze, narrower road
             gaze_zones = eye_zone_map(zones, config.eyes_road_margin_deg)
-            gaze_pitch = (
-                state.neutral_pitch_deg if eyes.gaze_pitch_deg is None else eyes.gaze_pitch_deg
-            )
             zone = gaze_zones.classify(
-                eyes.gaze_yaw_deg - state.neutral_yaw_deg,
-                gaze_pitch - state.neutral_pitch_deg,
+                (eyes.gaze_yaw_deg or 0.0) - state.neutral_yaw_deg,
+                (eyes.gaze_pitch_deg or 0.0) - state.neutral_pitch_deg,
                 state.face_zone,
             )
         else:

@@ -228,6 +228,13 @@ class Verdict:
     eyes: EyesVerdict = field(default_factory=EyesVerdict)
     """The eyes: open, closed or unavailable, gaze, closure, PERCLOS, blinks."""
 
+    @property
+    def eyes_on_road(self) -> bool | None:
+        """Looking at the road with the eyes not closed; None when the gaze is unknown."""
+        if self.on_road is None:
+            return None
+        return self.on_road and self.eyes.status is not EyeStatus.CLOSED
+
 
 @dataclass(frozen=True, slots=True)
 class FrameRecord:

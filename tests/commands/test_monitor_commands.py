@@ -35,14 +35,22 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     assert {"yaw_deg", "off_road_s"} <= set(schemas["alert"]["properties"])
     yaw_fields = {"schema", "vehicle_id", "seq", "t_s", "frame", "face", "yaw_deg", "yaw_raw_deg"}
     assert yaw_fields | {"on_road"} <= set(schemas["yaw"]["properties"])
-    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/1"
+    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/2"
     # roadgaze.yaw/2 extends /1 with the pose and the zone; every field is always published
     new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
     assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
-    assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/2"
-    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/2"
+    assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/3"
+    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/3"
     snapshot = schemas["state"]["$defs"]["MonitorSnapshot"]
     assert {"zone", "neutral_pitch_deg", "pitch_deg"} <= set(snapshot["required"])
+    # yaw/3 and state/3 add the eyes; alert/2 the closure and drowsiness kinds
+    eye_fields = {"eyes", "eye_openness", "gaze_yaw_deg", "gaze_pitch_deg", "gaze_source"}
+    eye_fields |= {"closure_s", "perclos", "blinks", "eyes_unavailable_s", "degraded"}
+    assert eye_fields <= set(schemas["yaw"]["required"])
+    assert eye_fields <= set(snapshot["required"])
+    kinds = set(schemas["alert"]["$defs"]["AlertKind"]["enum"])
+    assert {"microsleep", "sleep", "drowsy", "unresponsive", "degraded"} <= kinds
+    assert {"closure_s", "perclos", "reason"} <= set(schemas["alert"]["required"])
 
 
 def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from roadgaze.errors import RoadgazeError
-from roadgaze.types import ClosesOnExit, Frame, FrameRecord
+from roadgaze.types import ClosesOnExit, EyesVerdict, Frame, FrameRecord
 
 RECORD_FIELDS = (
     "t_s",
@@ -41,11 +41,26 @@ RECORD_FIELDS = (
     "off_road_s",
     "window_off_road_s",
     "distraction_s",
+    "eyes",
+    "eyes_reason",
+    "eye_openness",
+    "eye_yaw_deg",
+    "eye_pitch_deg",
+    "gaze_yaw_deg",
+    "gaze_pitch_deg",
+    "gaze_source",
+    "closure_s",
+    "perclos",
+    "blinks",
+    "long_blinks",
+    "eyes_unavailable_s",
+    "degraded",
     "alerts",
     "yaw_offline_deg",
     "pitch_offline_deg",
 )
-"""The fields of `record_fields`, in order (x_* in pixels of the roll-removed frame).
+"""The fields of `record_fields`, in order (x_* in pixels of the roll-removed frame; the eye
+fields as `roadgaze.types.EyesVerdict` defines them, `eyes` is open, closed or unavailable).
 `yaw_offline_deg` / `pitch_offline_deg` are null while a replay streams; `fill_offline_columns`
 fills them at its end."""
 
@@ -82,15 +97,36 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "on_road": verdict.on_road,
         "gaze": verdict.gaze.value,
         "zone": verdict.zone,
-        "eyes_on_road": verdict.on_road,
+        "eyes_on_road": verdict.eyes_on_road,
         "neutral_yaw_deg": round(verdict.neutral_yaw_deg, 3),
         "neutral_pitch_deg": round(verdict.neutral_pitch_deg, 3),
         "off_road_s": round(verdict.off_road_s, 3),
         "window_off_road_s": round(verdict.window_off_road_s, 3),
         "distraction_s": round(verdict.distraction_s, 3),
+        **eye_fields(verdict.eyes),
         "alerts": [alert.label for alert in record.alerts],
         "yaw_offline_deg": None,
         "pitch_offline_deg": None,
+    }
+
+
+def eye_fields(eyes: EyesVerdict) -> dict[str, Any]:
+    """The eye part of the record (`eyes` ... `degraded` in RECORD_FIELDS)."""
+    return {
+        "eyes": eyes.status.value,
+        "eyes_reason": eyes.reason,
+        "eye_openness": rounded(eyes.openness, 3),
+        "eye_yaw_deg": rounded(eyes.eye_yaw_deg, 2),
+        "eye_pitch_deg": rounded(eyes.eye_pitch_deg, 2),
+        "gaze_yaw_deg": rounded(eyes.gaze_yaw_deg, 2),
+        "gaze_pitch_deg": rounded(eyes.gaze_pitch_deg, 2),
+        "gaze_source": eyes.gaze_source,
+        "closure_s": round(eyes.closure_s, 3),
+        "perclos": rounded(eyes.perclos, 4),
+        "blinks": eyes.blinks,
+        "long_blinks": eyes.long_blinks,
+        "eyes_unavailable_s": round(eyes.unavailable_s, 3),
+        "degraded": eyes.degraded,
     }
 
 

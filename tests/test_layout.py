@@ -26,6 +26,7 @@ PURE_MODULES = (
     "roadgaze.transport.messages",
     "roadgaze.transport.keys",
     "roadgaze.transport.speed",
+    "roadgaze.transport.vss",
     "roadgaze.landmarks.features",
     "roadgaze.landmarks.driver",
     "roadgaze.landmarks.eyes",

@@ -267,6 +267,11 @@ class ZenohConfig(_Section):
     prefix: str = "vehicle/{vehicle_id}/dms"
     speed_key: str = "vehicle/{vehicle_id}/speed"
     """Key expression of the speed input; '' for none. Without a (fresh) speed: taken as moving."""
+    vss: bool = False
+    """Also publish the COVESA VSS driver signals (docs/zenoh.md), as `--vss` does."""
+    vss_prefix: str = Field(default="", pattern=r"^[^*$?#\s]*$")
+    """Key prefix of the VSS signals; '' publishes the bare VSS paths (one vehicle per network,
+    as Eclipse Kuksa assumes), e.g. 'car-0' gives car-0/Vehicle/Driver/IsEyesOnRoad."""
     speed_stale_s: float = Field(default=5.0, gt=0)
     """A speed older than this (wall time) is forgotten and the vehicle taken as moving again."""
     reconnect_initial_s: float = Field(default=0.5, gt=0)

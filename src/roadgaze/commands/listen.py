@@ -17,12 +17,14 @@ def register(subparsers: Any) -> None:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "listen",
         parents=[common_options()],
-        help="print the yaw, alert, state and liveliness messages of one vehicle (or all)",
+        help="print the yaw, alert, state and liveliness messages of one vehicle (or all), and "
+        "with --vss the COVESA VSS signals",
         description="Subscribe to vehicle/<id>/dms/{yaw,alert,state} and the liveliness token "
         "vehicle/<id>/dms/alive, and print each message: readable lines, or one JSON object per "
         "line with --json. Without --vehicle-id every vehicle is shown. With --query-state, ask "
         "the state queryable once, print the answers and exit: 0 when every answer says running, "
-        "3 when one is degraded (or starting/stopping), 1 without an answer (a health check).",
+        "3 when one is degraded (or starting/stopping), 1 without an answer (a health check). "
+        "With --vss, also the COVESA VSS driver signals (Vehicle/**, under zenoh.vss_prefix).",
     )
     add_zenoh_options(parser)
     parser.add_argument("--json", action="store_true", help="one JSON object per line")
@@ -64,6 +66,10 @@ def format_pretty(kind: str, vehicle: str, payload: dict[str, Any] | None, raw: 
         )
         if payload.get("clears"):
             text += " clears=" + ",".join(payload["clears"])
+        if payload.get("closure_s"):
+            text += f" closure={payload['closure_s']:.2f}s"
+        if payload.get("reason"):
+            text += f" ({payload['reason']})"
         return text
     if kind == "yaw":
         yaw = payload.get("yaw_deg")
@@ -73,7 +79,10 @@ def format_pretty(kind: str, vehicle: str, payload: dict[str, Any] | None, raw: 
             return f"{line} {payload.get('gaze')}"
         pitch = payload.get("pitch_deg")
         pitch_text = "    --  " if pitch is None else f"{pitch:+7.1f}°"
-        return f"{line} pitch {pitch_text} {payload.get('zone') or payload.get('gaze')}"
+        line = f"{line} pitch {pitch_text} {payload.get('zone') or payload.get('gaze')}"
+        if "eyes" not in payload:  # roadgaze.yaw/2
+            return line
+        return f"{line} {_eyes_text(payload)}"
     if kind == "state":
         transport = payload.get("transport", {})
         return (
@@ -81,6 +90,28 @@ def format_pretty(kind: str, vehicle: str, payload: dict[str, Any] | None, raw: 
             f"alerts_sent={transport.get('alerts_sent')} problems={payload.get('problems')}"
         )
     return f"{kind:<6} {vehicle} {raw[:200]}"
+
+
+def _eyes_text(payload: dict[str, Any]) -> str:
+    """The eyes of a yaw/3 message in a few words: state, openness, gaze, closure, PERCLOS."""
+    eyes = str(payload.get("eyes"))
+    openness = payload.get("eye_openness")
+    text = f"eyes {eyes}" + ("" if openness is None else f" {openness:.2f}")
+    gaze = payload.get("gaze_yaw_deg")
+    if gaze is not None and payload.get("gaze_source") == "eyes":
+        text += f" gaze {gaze:+.1f}°/{payload.get('gaze_pitch_deg') or 0.0:+.1f}°"
+    if payload.get("closure_s"):
+        text += f" closed {payload['closure_s']:.1f}s"
+    if payload.get("perclos") is not None:
+        text += f" perclos {payload['perclos']:.2f}"
+    if payload.get("degraded"):
+        text += " DEGRADED"
+    return text
+
+
+def format_vss(key: str, raw: bytes) -> str:
+    """One readable line for a VSS value: `vss    Vehicle/Driver/IsEyesOnRoad = true`."""
+    return f"vss    {key} = {raw.decode('utf-8', errors='replace')[:60]}"
 
 
 def _decode(raw: bytes) -> tuple[dict[str, Any] | None, str]:
@@ -95,7 +126,7 @@ def _decode(raw: bytes) -> tuple[dict[str, Any] | None, str]:
 def run(args: argparse.Namespace, config: Config) -> int:
     import zenoh
 
-    from roadgaze.transport import Keys, open_session
+    from roadgaze.transport import Keys, open_session, vss_key
 
     zconf = zenoh_config_from_args(config.zenoh, args)
     keys = Keys.from_config(zconf, args.vehicle_id or "*")
@@ -111,6 +142,13 @@ def run(args: argparse.Namespace, config: Config) -> int:
             dropped += 1
 
     def print_line(kind: str, key: str, raw: bytes) -> None:
+        if kind == "vss":
+            if args.json:
+                text = raw.decode("utf-8", errors="replace")
+                print(json.dumps({"type": "vss", "key": key, "value": text}), flush=True)
+            else:
+                print(format_vss(key, raw), flush=True)
+            return
         payload, text = _decode(raw)
         vehicle = _vehicle_of(key, zconf.prefix)
         if args.json:
@@ -153,6 +191,13 @@ def run(args: argparse.Namespace, config: Config) -> int:
         if not args.no_yaw:
             entities.append(session.declare_subscriber(keys.yaw, on_data))
         entities.append(session.liveliness().declare_subscriber(keys.alive, on_alive, history=True))
+        if zconf.vss:
+            vss_keys = vss_key("Vehicle.**", zconf.vss_prefix)
+
+            def on_vss(sample: Any) -> None:
+                emit("vss", str(sample.key_expr), sample.payload.to_bytes())
+
+            entities.append(session.declare_subscriber(vss_keys, on_vss))
         printed = 0
         try:
             while args.count is None or printed < args.count:

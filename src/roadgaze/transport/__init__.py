@@ -9,6 +9,7 @@ from roadgaze.transport.messages import (
     STATE_SCHEMA,
     YAW_SCHEMA,
     AlertMessage,
+    EyeFields,
     MonitorSnapshot,
     StateMessage,
     TransportStatus,
@@ -23,14 +24,24 @@ from roadgaze.transport.session import (
     zenoh_error_text,
 )
 from roadgaze.transport.speed import SpeedInput, parse_speed_kmh
+from roadgaze.transport.vss import (
+    VSS_PATHS,
+    VssLink,
+    VssPublisher,
+    vss_key,
+    vss_text,
+    vss_values,
+)
 
 __all__ = [
     "ALERT_SCHEMA",
     "MESSAGE_MODELS",
     "STATE_SCHEMA",
+    "VSS_PATHS",
     "YAW_SCHEMA",
     "AlertMessage",
     "BusPublisher",
+    "EyeFields",
     "Health",
     "Keys",
     "MessageLink",
@@ -38,6 +49,8 @@ __all__ = [
     "SpeedInput",
     "StateMessage",
     "TransportStatus",
+    "VssLink",
+    "VssPublisher",
     "YawMessage",
     "ZenohLink",
     "build_zenoh_config",
@@ -45,5 +58,8 @@ __all__ = [
     "open_session",
     "parse_speed_kmh",
     "session_config_dict",
+    "vss_key",
+    "vss_text",
+    "vss_values",
     "zenoh_error_text",
 ]

@@ -7,7 +7,8 @@ Under the prefix (default `vehicle/{vehicle_id}/dms`):
 - `alert`: one `AlertMessage` per monitor event, priority INTERACTIVE_HIGH, congestion control
   BLOCK (an alert is never dropped by the local queue);
 - `alive`: a liveliness token, present while the daemon runs;
-- `state`: a queryable answering a `StateMessage` (status, counters, config summary).
+- `state`: a queryable answering a `StateMessage` (status, counters, config summary);
+- with `vss_keys`, one text publisher per COVESA VSS signal (`roadgaze.transport.vss`).
 
 When the session cannot be opened (client mode and no router, say) the link is degraded:
 monitoring goes on, messages are counted as not sent (alerts are kept in a small bounded queue
@@ -30,6 +31,7 @@ from roadgaze.transport.keys import Keys
 from roadgaze.transport.messages import AlertMessage, TransportStatus, YawMessage
 from roadgaze.transport.session import build_zenoh_config, zenoh_error_text
 from roadgaze.transport.speed import SpeedInput
+from roadgaze.transport.vss import VSS_ATTACHMENT
 
 log = logging.getLogger(__name__)
 
@@ -48,12 +50,22 @@ class _Declared:
         keys: Keys,
         state_reply: Callable[[], bytes] | None,
         speed: SpeedInput | None,
+        vss_keys: tuple[str, ...] = (),
     ) -> None:
         import zenoh
 
         self.session = session
         self._entities: list[Any] = []
+        self.vss: dict[str, Any] = {}
         try:
+            for key in vss_keys:
+                self.vss[key] = session.declare_publisher(
+                    key,
+                    encoding=zenoh.Encoding.TEXT_PLAIN,
+                    congestion_control=zenoh.CongestionControl.BLOCK,
+                    priority=zenoh.Priority.DATA,
+                )
+                self._entities.append(self.vss[key])
             self.yaw = session.declare_publisher(
                 keys.yaw,
                 encoding=zenoh.Encoding.APPLICATION_JSON,
@@ -121,9 +133,11 @@ class ZenohLink:
         keys: Keys,
         state_reply: Callable[[], bytes] | None = None,
         speed: SpeedInput | None = None,
+        vss_keys: tuple[str, ...] = (),
     ) -> None:
         self.config = config
         self.keys = keys
+        self.vss_keys = vss_keys
         self._state_reply = state_reply
         self.speed = speed
         self._zconf = build_zenoh_config(config)  # bad settings fail here, at once
@@ -134,6 +148,7 @@ class ZenohLink:
         self._thread: threading.Thread | None = None
         self.session_reopens = 0
         self.yaw_sent = 0
+        self.vss_sent = 0
         self.alerts_sent = 0
         self.not_sent = 0
         self.last_error: str | None = None
@@ -157,7 +172,7 @@ class ZenohLink:
 
         try:
             session = zenoh.open(self._zconf)
-            declared = _Declared(session, self.keys, self._state_reply, self.speed)
+            declared = _Declared(session, self.keys, self._state_reply, self.speed, self.vss_keys)
         except Exception as exc:
             self.last_error = zenoh_error_text(exc)
             log.warning("zenoh session not available (%s); monitoring goes on", self.last_error)
@@ -202,6 +217,21 @@ class ZenohLink:
         except Exception as exc:
             self.not_sent += 1
             self.last_error = f"yaw put failed: {exc}"
+
+    def publish_vss(self, key: str, payload: bytes) -> None:
+        """One VSS value (text) on its key, with Kuksa's `currentValue` attachment; counted as
+        not sent without a session (the next change is sent again)."""
+        declared = self._declared
+        publisher = None if declared is None else declared.vss.get(key)
+        if publisher is None:
+            self.not_sent += 1
+            return
+        try:
+            publisher.put(payload, attachment=VSS_ATTACHMENT)
+            self.vss_sent += 1
+        except Exception as exc:
+            self.not_sent += 1
+            self.last_error = f"vss put failed: {exc}"
 
     def publish_alert(self, message: AlertMessage) -> None:
         payload = message.to_json_bytes()
@@ -255,6 +285,7 @@ class ZenohLink:
             routers=routers,
             session_reopens=self.session_reopens,
             yaw_sent=self.yaw_sent,
+            vss_sent=self.vss_sent,
             alerts_sent=self.alerts_sent,
             not_sent=self.not_sent,
             pending_alerts=pending,

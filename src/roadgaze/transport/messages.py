@@ -216,6 +216,7 @@ class TransportStatus(_Message):
     routers: int = 0
     session_reopens: int = 0
     yaw_sent: int = 0
+    vss_sent: int = 0
     alerts_sent: int = 0
     not_sent: int = 0
     pending_alerts: int = 0

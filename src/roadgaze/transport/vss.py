@@ -1,0 +1,177 @@
+"""COVESA VSS 6.0 driver signals from the frame record, in Eclipse Kuksa's Zenoh convention. Pure.
+
+Each signal is published on its VSS path with `.` replaced by `/` (e.g.
+`Vehicle/Driver/IsEyesOnRoad`), under `zenoh.vss_prefix` when one is configured (Kuksa assumes one
+vehicle per Zenoh network and bare paths), the value as text (`true`/`false`, decimal numbers)
+with the attachment `currentValue`, which Kuksa's zenoh-kuksa-provider requires before it
+forwards a sample to the databroker. A value is sent when it changes, at most `VSS_MAX_RATE_HZ`
+times a second per signal on the source timeline; a change held back is sent once the interval
+has passed, so the last value always arrives.
+
+Values (definitions and how the levels are computed: docs/zenoh.md):
+
+- `IsEyesOnRoad`: on the road with the eyes not closed; false when unknown (fail-safe).
+- `DistractionLevel` = 100 min(1, max(distraction_s / long_distraction_s,
+  window_off_road_s / vats_threshold_s)): 100 % exactly when `long_distraction` or `vats` is due.
+- `FatigueLevel` = 100 min(1, max(PERCLOS / perclos_drowsy, long blinks / long_blinks_drowsy,
+  closure_s / microsleep_s)): 100 % exactly when `drowsy` or `microsleep` is due.
+- `AttentiveProbability` = q (100 - max(distraction, fatigue)) + (1 - q) 50, q the confidence
+  of the measurement (1 with the eyes judged, 0.6 on head pose only, 0 without a face). A
+  heuristic, not a calibrated probability.
+- `HeadPosition.Yaw/Pitch` and `MidEyeGaze.Azimuth/Elevation`: relative to the learned
+  road-ahead pose (VSS's "normal position"), degrees, yaw > 0 = turned left, pitch > 0 = up;
+  `HeadPosition.Roll` > 0 = leaning to the right (the project's roll). Not sent when unknown.
+- `ADAS.DMS.IsWarning`: an alert is active; `ADAS.DMS.IsError`: monitoring degraded (the eyes
+  unavailable too long).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Protocol
+
+from roadgaze.config import MonitorConfig
+from roadgaze.types import EyeStatus, Frame, FrameRecord, Gaze
+
+__all__ = [
+    "VSS_ATTACHMENT",
+    "VSS_MAX_RATE_HZ",
+    "VSS_PATHS",
+    "VssLink",
+    "VssPublisher",
+    "vss_key",
+    "vss_text",
+    "vss_values",
+]
+
+VSS_MAX_RATE_HZ = 10.0
+VSS_ATTACHMENT = b"currentValue"
+"""Kuksa's zenoh-kuksa-provider forwards only samples with this attachment."""
+DRIVER = "Vehicle.Driver"
+HEAD = "Vehicle.Occupant.Row1.DriverSide.HeadPosition"
+GAZE = "Vehicle.Occupant.Row1.DriverSide.MidEyeGaze"
+DMS = "Vehicle.ADAS.DMS"
+VSS_PATHS: tuple[str, ...] = (
+    f"{DRIVER}.IsEyesOnRoad",
+    f"{DRIVER}.DistractionLevel",
+    f"{DRIVER}.AttentiveProbability",
+    f"{DRIVER}.FatigueLevel",
+    f"{HEAD}.Yaw",
+    f"{HEAD}.Pitch",
+    f"{HEAD}.Roll",
+    f"{GAZE}.Azimuth",
+    f"{GAZE}.Elevation",
+    f"{DMS}.IsWarning",
+    f"{DMS}.IsError",
+)
+
+VssValue = bool | float
+
+
+def vss_key(path: str, prefix: str = "") -> str:
+    """The Zenoh key of a VSS path: dots become slashes, under `prefix` when one is given."""
+    key = path.replace(".", "/")
+    prefix = prefix.strip("/")
+    return f"{prefix}/{key}" if prefix else key
+
+
+def vss_text(value: VssValue) -> bytes:
+    """The value as Kuksa reads it: `true`/`false`, or a decimal number."""
+    if isinstance(value, bool):
+        return b"true" if value else b"false"
+    return repr(float(value)).encode("ascii")
+
+
+def _relative(value: float | None, neutral: float) -> float | None:
+    if value is None or not math.isfinite(value):
+        return None
+    return round(value - neutral, 1)
+
+
+def vss_values(record: FrameRecord, config: MonitorConfig) -> dict[str, VssValue]:
+    """The signals of one frame record (VSS path -> value); unknown angles are left out."""
+    sample, verdict = record.sample, record.verdict
+    eyes = verdict.eyes
+    distraction = 100.0 * min(
+        1.0,
+        max(
+            verdict.distraction_s / config.long_distraction_s,
+            verdict.window_off_road_s / config.vats_threshold_s,
+        ),
+    )
+    fatigue = 100.0 * min(
+        1.0,
+        max(
+            0.0 if eyes.perclos is None else eyes.perclos / config.perclos_drowsy,
+            eyes.long_blinks / config.long_blinks_drowsy,
+            eyes.closure_s / config.microsleep_s,
+        ),
+    )
+    if eyes.status is not EyeStatus.UNAVAILABLE:
+        confidence = 1.0
+    elif verdict.gaze is not Gaze.UNKNOWN:
+        confidence = 0.6
+    else:
+        confidence = 0.0
+    attentive = confidence * (100.0 - max(distraction, fatigue)) + (1.0 - confidence) * 50.0
+    values: dict[str, VssValue] = {
+        f"{DRIVER}.IsEyesOnRoad": verdict.eyes_on_road is True,
+        f"{DRIVER}.DistractionLevel": round(distraction, 1),
+        f"{DRIVER}.AttentiveProbability": round(attentive, 1),
+        f"{DRIVER}.FatigueLevel": round(fatigue, 1),
+        f"{DMS}.IsWarning": bool(verdict.active),
+        f"{DMS}.IsError": eyes.degraded,
+    }
+    angles = {
+        f"{HEAD}.Yaw": _relative(verdict.yaw_deg, verdict.neutral_yaw_deg),
+        f"{HEAD}.Pitch": _relative(verdict.pitch_deg, verdict.neutral_pitch_deg),
+        f"{HEAD}.Roll": _relative(sample.roll_deg, 0.0),
+        f"{GAZE}.Azimuth": _relative(eyes.gaze_yaw_deg, verdict.neutral_yaw_deg),
+        f"{GAZE}.Elevation": _relative(eyes.gaze_pitch_deg, verdict.neutral_pitch_deg),
+    }
+    values.update({path: value for path, value in angles.items() if value is not None})
+    return values
+
+
+class VssLink(Protocol):
+    """Where VSS values go: `ZenohLink.publish_vss` in production, a list in tests."""
+
+    def publish_vss(self, key: str, payload: bytes) -> None: ...
+
+
+class VssPublisher:
+    """Pipeline sink: each VSS signal on change, at most `max_rate_hz` per signal.
+
+    Time is the records' `t_s` (the source timeline), so a replay publishes what the vehicle
+    would have; a change held back by the rate limit is sent with the first record after the
+    interval, unless the value came back to what was last sent.
+    """
+
+    def __init__(
+        self,
+        link: VssLink,
+        config: MonitorConfig,
+        prefix: str = "",
+        max_rate_hz: float = VSS_MAX_RATE_HZ,
+    ) -> None:
+        self.link = link
+        self.config = config
+        self.keys = {path: vss_key(path, prefix) for path in VSS_PATHS}
+        self.min_interval_s = 1.0 / max_rate_hz
+        self._sent: dict[str, tuple[VssValue, float]] = {}
+        self.published = 0
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        t_s = record.t_s
+        for path, value in vss_values(record, self.config).items():
+            last = self._sent.get(path)
+            if last is not None and (
+                last[0] == value or t_s - last[1] < self.min_interval_s - 1e-9
+            ):
+                continue
+            self.link.publish_vss(self.keys[path], vss_text(value))
+            self._sent[path] = (value, t_s)
+            self.published += 1
+
+    def close(self) -> None:
+        """Nothing to release: the link is owned by whoever opened it."""

@@ -143,7 +143,12 @@ def _eye_fields(fields: list[str], item: str) -> tuple[float, float, float]:
             raise ConfigError(f"timeline keyframe '{item}': field '{key}' given twice")
         seen.add(key)
         if key == "eyes":
-            value = EYES_WORDS[text] if text in EYES_WORDS else _number(text, "eyes", item)
+            value = EYES_WORDS.get(text, math.nan)
+            if text not in EYES_WORDS:
+                try:
+                    value = float(text)
+                except ValueError:
+                    value = math.nan
             if not 0.0 <= value <= 1.0:
                 raise ConfigError(
                     f"timeline keyframe '{item}': eyes must be open, closed, half or a number "

@@ -22,8 +22,9 @@ class EyesConfig(BaseModel):
     method: Literal["blendshapes", "iris"] = "blendshapes"
     """Eye-in-head direction from MediaPipe's eyeLook* blendshapes, or from the iris landmarks
     with an eyeball-centre model (a diagnostic: worse on real faces)."""
-    max_head_yaw_deg: float = Field(default=60.0, gt=0, le=90)
-    """Beyond this head yaw the eyes give no direction (the yaw model saturates)."""
+    max_head_yaw_deg: float = Field(default=45.0, gt=0, le=90)
+    """Beyond this head yaw the eyes give no direction: MediaPipe's eye direction degrades with
+    the head turned (docs/eyes.md)."""
     closure_max_head_yaw_deg: float = Field(default=80.0, gt=0, le=90)
     """Up to this head yaw the nearer eye's openness is still judged."""
     far_eye_max_yaw_deg: float = Field(default=35.0, ge=0, le=90)

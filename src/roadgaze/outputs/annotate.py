@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.outputs.annotate_eyes import draw_eyes, eyes_text
 from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
 from roadgaze.types import ClosesOnExit, FaceFeatures, Frame, FrameRecord, PoseSample
 
@@ -132,8 +133,9 @@ def annotate(image: npt.NDArray[np.uint8], record: FrameRecord) -> npt.NDArray[n
             ends = roll_frame.to_image(np.array([[x_px, top], [x_px, bottom]]))
             (x0, y0), (x1, y1) = ends
             cv2.line(canvas, (round(x0), round(y0)), (round(x1), round(y1)), colour, thickness)
+    draw_eyes(canvas, record, scale)
     _draw_gauge(canvas, sample, scale)
-    lines_text = [_yaw_text(sample), _state_text(sample), verdict_text(record)]
+    lines_text = [_yaw_text(sample), _state_text(sample), eyes_text(record), verdict_text(record)]
     _draw_text_panel(canvas, lines_text, scale, thickness)
     return canvas
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from roadgaze.errors import RoadgazeError
+from roadgaze.outputs.plot_eyes import EyeTrace
 from roadgaze.types import Alert, ClosesOnExit, FloatArray, Frame, FrameRecord
 
 ALERT_COLOURS = {"warning": "tab:orange", "critical": "tab:red", "info": "tab:green"}
@@ -19,7 +20,8 @@ class YawPlot(ClosesOnExit):
     Drawn: raw yaw (points), smoothed yaw with its +-2 sigma band, each alert as a dashed line
     with its kind; with `truth` (rows `t_s, yaw_deg, pitch_deg`) the true yaw too, and with
     `road_half_width_deg` the road-ahead band around 0. A second panel shows raw and smoothed
-    pitch (and the true pitch) when any record has a pitch.
+    pitch (and the true pitch) when any record has a pitch; with the eyes measured, the gaze yaw
+    joins the yaw panel and a last panel shows the eyes (`roadgaze.outputs.plot_eyes`).
     """
 
     def __init__(
@@ -39,6 +41,7 @@ class YawPlot(ClosesOnExit):
         self.std_deg: list[float] = []
         self.pitch_raw_deg: list[float] = []
         self.pitch_deg: list[float] = []
+        self.eyes = EyeTrace()
         self.alerts: list[Alert] = []
         self._closed = False
 
@@ -50,6 +53,7 @@ class YawPlot(ClosesOnExit):
         self.std_deg.append(_nan_for_none(sample.yaw_std_deg))
         self.pitch_raw_deg.append(_nan_for_none(sample.pitch_raw_deg))
         self.pitch_deg.append(_nan_for_none(sample.pitch_deg))
+        self.eyes.add(record)
         self.alerts.extend(record.alerts)
 
     def close(self) -> None:
@@ -65,12 +69,21 @@ class YawPlot(ClosesOnExit):
         smoothed = np.asarray(self.smoothed_deg)
         std = np.asarray(self.std_deg)
         with_pitch = bool(np.any(np.isfinite(self.pitch_raw_deg)))
-        if with_pitch:
-            figure, (axes, pitch_axes) = plt.subplots(
-                2, 1, figsize=(10, 7), dpi=110, sharex=True, height_ratios=(3, 2)
-            )
-        else:
-            figure, axes = plt.subplots(figsize=(10, 4.5), dpi=110)
+        with_eyes = self.eyes.measured
+        ratios = (3, *((2,) if with_pitch else ()), *((2,) if with_eyes else ()))
+        figure, panels = plt.subplots(
+            len(ratios),
+            1,
+            figsize=(10, 4.5 + 2.5 * (len(ratios) - 1)),
+            dpi=110,
+            sharex=True,
+            height_ratios=ratios,
+            squeeze=False,
+        )
+        axes = panels[0, 0]
+        pitch_axes = panels[1, 0] if with_pitch else None
+        if with_eyes:
+            self.eyes.draw(axes, panels[-1, 0], self.truth)
         if self.road_half_width_deg is not None:
             half = self.road_half_width_deg
             axes.axhspan(-half, half, color="tab:green", alpha=0.08, label="road ahead")
@@ -92,7 +105,7 @@ class YawPlot(ClosesOnExit):
         axes.set_title(self.title or "head pose")
         axes.legend(loc="lower left", fontsize=8)
         axes.grid(alpha=0.3)
-        if with_pitch:
+        if pitch_axes is not None:
             if self.truth is not None and self.truth.shape[1] > 2:
                 pitch_axes.plot(
                     self.truth[:, 0], self.truth[:, 2], "-", color="black", lw=1.2, label="truth"
@@ -105,9 +118,7 @@ class YawPlot(ClosesOnExit):
             pitch_axes.set_ylabel("pitch (deg, + = up)")
             pitch_axes.legend(loc="lower left", fontsize=8)
             pitch_axes.grid(alpha=0.3)
-            pitch_axes.set_xlabel("time (s)")
-        else:
-            axes.set_xlabel("time (s)")
+        panels[-1, 0].set_xlabel("time (s)")
         figure.tight_layout()
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)

@@ -147,7 +147,8 @@ def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) ->
         print(
             f"replay {args.source}: alert {alert.kind.value} {alert.level.value} "
             f"at t={alert.t_s:.2f}s (off road {alert.off_road_s:.2f}s, "
-            f"window {alert.window_off_road_s:.2f}s)",
+            f"window {alert.window_off_road_s:.2f}s)"
+            + (f": {alert.reason}" if alert.reason else ""),
             file=sys.stderr,
         )
 

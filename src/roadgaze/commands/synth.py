@@ -54,7 +54,8 @@ def register(subparsers: Any) -> None:
         "--timeline",
         default=EXAMPLE_TIMELINE,
         metavar="SPEC",
-        help=f"keyframes YAW[/PITCH]:SECONDS,... (default {EXAMPLE_TIMELINE}); with "
+        help=f"keyframes YAW[/PITCH][;FIELD=VALUE...]:SECONDS,... (default {EXAMPLE_TIMELINE}); "
+        "'eyes': a drive with a 1.5 s and a 4 s eye closure and an eyes-only glance; with "
         "--measure-clip also 'demo' (the demo's drive) or 'pose' (a yaw/pitch drive, the default)",
     )
     parser.add_argument("--out", type=Path, metavar="VIDEO", help="output .mp4, .avi or .mkv")
@@ -206,7 +207,12 @@ def run(args: argparse.Namespace, config: Config) -> int:
         return 0
     if args.out is None:
         raise ConfigError("--out VIDEO is required to render a clip (or pass --measure)")
-    timeline = parse_timeline(args.timeline, args.transition, args.eye_transition)
+    spec = args.timeline
+    if spec == "eyes":
+        from roadgaze.synth import EYE_DRIVE_TIMELINE
+
+        spec = EYE_DRIVE_TIMELINE
+    timeline = parse_timeline(spec, args.transition, args.eye_transition)
     load_photo(args.photo)  # fail fast on a bad photo before any work
     truth = render_clip(timeline, args.out, photo=args.photo, fps=args.fps, size=size)
     print(

@@ -18,6 +18,7 @@ from roadgaze.synth.clip_measure import (
     measure_clip,
 )
 from roadgaze.synth.eye_measure import (
+    EYE_DRIVE_TIMELINE,
     EyeRecovery,
     format_eye_measurement,
     measure_eye_recovery,
@@ -60,6 +61,7 @@ __all__ = [
     "DEFAULT_FPS",
     "DEFAULT_SIZE",
     "DEFAULT_TRANSITION_S",
+    "EYE_DRIVE_TIMELINE",
     "EYE_TRUTH_HEADER",
     "MAX_ABS_PITCH_DEG",
     "MAX_ABS_YAW_DEG",

@@ -27,6 +27,11 @@ from roadgaze.synth.eyes import EyeRenderer, EyeState
 from roadgaze.synth.renderer import load_photo
 from roadgaze.types import EyeStatus, FloatArray
 
+EYE_DRIVE_TIMELINE = (
+    "0:4,0;eyes=closed:1.5,0:4,0;eyes=closed:4,0:4,0;eye_yaw=-30;eye_pitch=-25:4,0:4"
+)
+"""A drive with a 1.5 s and a 4 s closure and a 4 s eyes-only glance down to the right, head
+still (`roadgaze synth --timeline eyes`): microsleep, microsleep + sleep, long_distraction."""
 EYE_YAWS_DEG = (-30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0)
 EYE_PITCHES_DEG = (-20.0, -10.0, 0.0, 10.0, 20.0)
 TURNED_HEAD_YAWS_DEG = (-20.0, 20.0)

@@ -193,9 +193,10 @@ class MonitorConfig(_Section, EyeMonitorSettings):
     )
     """Zones whose time counts as off road (VATS, eyes_on_road) but does not run the
     long-distraction timer."""
-    driving_glance_max_s: float | None = Field(default=None, gt=0)
-    """A continuous stay in a driving-related zone longer than this counts as distraction from
-    its start; None: never."""
+    driving_glance_max_s: float | None = Field(default=4.0, gt=0)
+    """A continuous stay in a driving-related zone this long is a stare, not a glance: it counts as
+    distraction from its start (fail-safe: a long look out of the side window is not excused as a
+    mirror check); None: never."""
     neutral_yaw_deg: float | None = None
     """Fixed road-ahead yaw; None learns it online from on-road samples."""
     neutral_pitch_deg: float | None = None

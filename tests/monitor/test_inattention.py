@@ -399,20 +399,32 @@ AWAY_POSE = (AWAY_YAW_DEG, 0.0)
 LAP = (0.0, -35.0)
 
 
-def test_a_long_mirror_glance_is_off_road_but_raises_no_long_distraction() -> None:
+def test_a_mirror_glance_is_off_road_but_raises_no_long_distraction() -> None:
     _, alerts, zones = run_poses(
-        segments((1.0, ROAD_POSE), (8.0, LEFT_MIRROR), (2.0, ROAD_POSE)), 11.0
+        segments((1.0, ROAD_POSE), (3.5, LEFT_MIRROR), (2.0, ROAD_POSE)), 6.5
     )
     assert alerts == []
     assert zones[60] == "left_mirror" and zones[-1] == "road"
     inside = Monitor(FIXED)
-    for frame in range(round(5.0 * FPS)):
+    for frame in range(round(4.0 * FPS)):
         inside.update(sample(frame / FPS, 0.0 if frame < 30 else 45.0, frame, 0.0))
     verdict = inside.verdict
     assert (verdict.zone, verdict.on_road, verdict.gaze) == ("left_mirror", False, Gaze.OFF_ROAD)
-    assert verdict.off_road_s == pytest.approx(4.0 - FRAME_S, abs=1e-6)
-    assert verdict.window_off_road_s == pytest.approx(4.0 - FRAME_S, abs=1e-6)
+    assert verdict.off_road_s == pytest.approx(3.0 - FRAME_S, abs=1e-6)
+    assert verdict.window_off_road_s == pytest.approx(3.0 - FRAME_S, abs=1e-6)
     assert verdict.distraction_s == 0.0
+
+
+def test_a_mirror_stare_of_the_default_limit_is_a_long_distraction() -> None:
+    """Fail-safe default: 4 s in a mirror zone is a stare (or a look out of the side window)."""
+    _, alerts, _ = run_poses(segments((1.0, ROAD_POSE), (8.0, LEFT_MIRROR), (2.0, ROAD_POSE)), 11.0)
+    assert kinds(alerts)[0] == ("long_distraction", "warning")
+    assert_within_one_frame(alerts[0].t_s, 1.0 + 4.0)
+    excused = FIXED.model_copy(update={"driving_glance_max_s": None})
+    _, none_raised, _ = run_poses(
+        segments((1.0, ROAD_POSE), (8.0, LEFT_MIRROR), (2.0, ROAD_POSE)), 11.0, excused
+    )
+    assert none_raised == []
 
 
 def test_mirror_glances_count_for_vats() -> None:

@@ -146,7 +146,8 @@ def test_unresponsive_when_not_back_three_seconds_after_a_vats_warning() -> None
                 return 50.0, eyes_of()
         return 0.0, eyes_of()
 
-    _, alerts = run(script, 24.0, MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=0.0))
+    config = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=0.0, driving_glance_max_s=None)
+    _, alerts = run(script, 24.0, config)
     assert kinds(alerts)[:2] == ["vats:warning", "unresponsive:critical"]
     assert alerts[1].reason == "not back on road after a warning"
     assert near(alerts[1].t_s - alerts[0].t_s, 3.0)

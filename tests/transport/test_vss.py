@@ -128,12 +128,20 @@ def test_values_go_out_on_change_at_most_ten_times_a_second() -> None:
     fatigue = [(t, payload) for t, key, payload in link.puts if key.endswith("FatigueLevel")]
     assert fatigue[0][1] == b"0.0" and fatigue[-1][1] == b"0.0"
     assert min(b[0] - a[0] for a, b in itertools.pairwise(fatigue)) >= 0.1 - 1e-6
-    # rising through the closure: about 10 values a second until 100 %, none while it holds
+    # rising through the closure: about 10 values a second until 100 %, then once a second
     assert b"100.0" in [payload for _, payload in fatigue]
     assert 8 <= sum(1 for _, p in fatigue if p not in (b"0.0", b"100.0")) <= 12
+    assert 2 <= sum(1 for _, p in fatigue if p == b"100.0") <= 3
     assert "car-1/Vehicle/Driver/IsEyesOnRoad" in {key for _, key, _ in link.puts}
-    eyes_on_road = [p for _, k, p in link.puts if k.endswith("IsEyesOnRoad")]
-    assert eyes_on_road == [b"true", b"false", b"true"]  # only the changes
+    eyes_on_road = [(t, p) for t, k, p in link.puts if k.endswith("IsEyesOnRoad")]
+    # the changes (at 2.0 and 5.0 s), and the value again every second without a change
+    changes = [
+        (t, p) for i, (t, p) in enumerate(eyes_on_road) if i == 0 or p != eyes_on_road[i - 1][1]
+    ]
+    assert [p for _, p in changes] == [b"true", b"false", b"true"]
+    assert [round(t, 1) for t, _ in changes] == [0.0, 2.0, 5.0]
+    assert len(eyes_on_road) == 6  # 0, 1, 2 (false), 3, 4, 5 (true)
+    assert max(b[0] - a[0] for a, b in itertools.pairwise(eyes_on_road)) <= 1.0 + 1e-6
     assert publisher.published == len(link.puts)
 
 

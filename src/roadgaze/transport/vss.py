@@ -6,7 +6,9 @@ vehicle per Zenoh network and bare paths), the value as text (`true`/`false`, de
 with the attachment `currentValue`, which Kuksa's zenoh-kuksa-provider requires before it
 forwards a sample to the databroker. A value is sent when it changes, at most `VSS_MAX_RATE_HZ`
 times a second per signal on the source timeline; a change held back is sent once the interval
-has passed, so the last value always arrives.
+has passed, so the last value always arrives. Every value is also sent again `VSS_REFRESH_S`
+after it was last sent, so a subscriber that joins late (or a Kuksa provider that restarted)
+has the whole state within a second, and a silent key means a silent service.
 
 Values (definitions and how the levels are computed: docs/zenoh.md):
 
@@ -37,6 +39,7 @@ __all__ = [
     "VSS_ATTACHMENT",
     "VSS_MAX_RATE_HZ",
     "VSS_PATHS",
+    "VSS_REFRESH_S",
     "VssLink",
     "VssPublisher",
     "vss_key",
@@ -45,6 +48,7 @@ __all__ = [
 ]
 
 VSS_MAX_RATE_HZ = 10.0
+VSS_REFRESH_S = 1.0
 VSS_ATTACHMENT = b"currentValue"
 """Kuksa's zenoh-kuksa-provider forwards only samples with this attachment."""
 DRIVER = "Vehicle.Driver"
@@ -140,7 +144,8 @@ class VssLink(Protocol):
 
 
 class VssPublisher:
-    """Pipeline sink: each VSS signal on change, at most `max_rate_hz` per signal.
+    """Pipeline sink: each VSS signal on change, at most `max_rate_hz` per signal, and again
+    every `refresh_s` without a change.
 
     Time is the records' `t_s` (the source timeline), so a replay publishes what the vehicle
     would have; a change held back by the rate limit is sent with the first record after the
@@ -153,11 +158,13 @@ class VssPublisher:
         config: MonitorConfig,
         prefix: str = "",
         max_rate_hz: float = VSS_MAX_RATE_HZ,
+        refresh_s: float = VSS_REFRESH_S,
     ) -> None:
         self.link = link
         self.config = config
         self.keys = {path: vss_key(path, prefix) for path in VSS_PATHS}
         self.min_interval_s = 1.0 / max_rate_hz
+        self.refresh_s = refresh_s
         self._sent: dict[str, tuple[VssValue, float]] = {}
         self.published = 0
 
@@ -165,10 +172,13 @@ class VssPublisher:
         t_s = record.t_s
         for path, value in vss_values(record, self.config).items():
             last = self._sent.get(path)
-            if last is not None and (
-                last[0] == value or t_s - last[1] < self.min_interval_s - 1e-9
-            ):
-                continue
+            if last is not None:
+                since_s = t_s - last[1]
+                due = since_s >= self.refresh_s - 1e-9 or (
+                    last[0] != value and since_s >= self.min_interval_s - 1e-9
+                )
+                if not due:
+                    continue
             self.link.publish_vss(self.keys[path], vss_text(value))
             self._sent[path] = (value, t_s)
             self.published += 1

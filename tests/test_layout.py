@@ -31,7 +31,6 @@ PURE_MODULES = (
     "roadgaze.landmarks.driver",
     "roadgaze.landmarks.eyes",
     "roadgaze.config_eyes",
-    "roadgaze.landmarks.eye_contrast",
     "roadgaze.eye_records",
     "roadgaze.evaluation.stats",
     "roadgaze.synth.timeline",

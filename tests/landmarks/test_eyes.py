@@ -275,3 +275,37 @@ def test_iris_468_is_the_persons_right_eye_on_a_frontal_still() -> None:
     assert np.linalg.norm(points[468] - right_middle) < 6
     assert np.linalg.norm(points[473] - left_middle) < 6
     assert right_middle[0] < left_middle[0]  # the person's right eye is on the image's left
+
+
+@pytest.mark.parametrize("shade", [20, 60])
+def test_painted_sunglasses_hide_the_eyes(photo_face: object, shade: int) -> None:
+    """MediaPipe still reports open eyes behind dark lenses; the contrast check hides them."""
+    import cv2
+
+    from roadgaze.config import Config
+    from roadgaze.landmarks import MediaPipeLandmarker
+    from roadgaze.synth import load_photo
+    from roadgaze.types import FaceFeatures
+
+    assert isinstance(photo_face, FaceFeatures)
+    image = load_photo().copy()
+    for eye in EYES:
+        points = photo_face.landmarks_px[list(eye.contour), :2]
+        centre = points.mean(axis=0)
+        axes = (0.75 * float(np.ptp(points[:, 0])), 1.2 * float(np.ptp(points[:, 1])) + 6)
+        cv2.ellipse(
+            image,
+            (round(centre[0]), round(centre[1])),
+            (round(axes[0]), round(axes[1])),
+            0,
+            0,
+            360,
+            (shade, shade, shade),
+            -1,
+        )
+    with MediaPipeLandmarker.from_config(Config()) as landmarker:
+        face = landmarker.detect(image).driver
+    eyes = driver_eyes(face, 0.0)
+    assert eyes is not None and face is not None and face.eye_contrast is not None
+    assert max(face.eye_contrast) < 0.15
+    assert eyes.occluded and not eyes.gaze_available and not eyes.closure_available

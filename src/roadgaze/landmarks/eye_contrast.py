@@ -1,4 +1,4 @@
-"""Can the eyes be seen at all: the contrast inside the eye opening (pure numpy).
+"""Can the eyes be seen at all: the contrast inside the eye opening.
 
 An open eye shows bright sclera beside a dark iris; a dark lens, glare or a hand is flat. Measured
 relative to the skin just below the eye, so it does not depend on the exposure. With the lids
@@ -35,6 +35,17 @@ def polygon_mask(polygon: FloatArray, shape: tuple[int, int]) -> npt.NDArray[np.
     return inside
 
 
+def _fill_polygon(polygon: FloatArray, shape: tuple[int, int]) -> npt.NDArray[np.bool_]:
+    """`polygon_mask` by OpenCV's rasteriser (sub-pixel vertices): the same pixels up to edge
+    rounding, ten times faster."""
+    import cv2
+
+    mask = np.zeros(shape, dtype=np.uint8)
+    vertices = np.round((polygon - 0.5) * 16).astype(np.int32)
+    cv2.fillPoly(mask, [vertices], 1, lineType=cv2.LINE_8, shift=4)
+    return mask.astype(bool)
+
+
 def eye_contrast(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndices) -> float:
     """Contrast of one eye opening: (p90 - p10 of its pixels) / the median of the skin below it.
 
@@ -52,7 +63,7 @@ def eye_contrast(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndic
     y1 = min(image.shape[0], math.ceil(float(polygon[:, 1].max())) + 1)
     if x1 - x0 < 4 or y1 - y0 < 2 or width < 6:
         return math.nan
-    mask = polygon_mask(polygon - np.array([x0, y0]), (y1 - y0, x1 - x0))
+    mask = _fill_polygon(polygon - np.array([x0, y0]), (y1 - y0, x1 - x0))
     values = image[y0:y1, x0:x1][mask].astype(np.float64)
     if values.size < 6:
         return math.nan
@@ -63,5 +74,5 @@ def eye_contrast(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndic
     if skin.size == 0:
         return math.nan
     reference = max(float(np.median(skin)), 1.0)
-    p10, p90 = np.percentile(values, [10, 90])
+    p10, p90 = np.quantile(values, [0.1, 0.9])
     return float((p90 - p10) / reference)

@@ -17,6 +17,10 @@ import numpy.typing as npt
 from roadgaze.landmarks.eyes import EyeIndices
 from roadgaze.types import FloatArray
 
+MIN_EYE_WIDTH_PX = 16.0
+"""Narrower eyes are not checked (NaN): a blurred open eye 11.5 px wide (Intel's sample GIF)
+reads as flat as a lens, while Pointing'04's eyes (about 23 px) never do."""
+
 
 def polygon_mask(polygon: FloatArray, shape: tuple[int, int]) -> npt.NDArray[np.bool_]:
     """Pixels (by their centres) inside a polygon, even-odd rule; `shape` is (height, width)."""
@@ -51,7 +55,8 @@ def eye_contrast(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndic
 
     An open eye shows bright sclera beside a dark iris; a dark lens (or a closed lid) is flat.
     The skin is a band from 0.35 to 0.6 eye widths below the lower lid, as wide as the eye.
-    `gray`: a 2-D uint8 or float image. NaN when the eye is too small or off the image.
+    `gray`: a 2-D uint8 or float image. NaN when the eye is narrower than `MIN_EYE_WIDTH_PX` or
+    off the image.
     """
     image: npt.NDArray[Any] = np.asarray(gray)
     points = np.asarray(landmarks_px, dtype=np.float64)[:, :2]
@@ -61,7 +66,7 @@ def eye_contrast(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndic
     x1 = min(image.shape[1], math.ceil(float(polygon[:, 0].max())) + 1)
     y0 = max(0, math.floor(float(polygon[:, 1].min())))
     y1 = min(image.shape[0], math.ceil(float(polygon[:, 1].max())) + 1)
-    if x1 - x0 < 4 or y1 - y0 < 2 or width < 6:
+    if x1 - x0 < 4 or y1 - y0 < 2 or width < MIN_EYE_WIDTH_PX:
         return math.nan
     mask = _fill_polygon(polygon - np.array([x0, y0]), (y1 - y0, x1 - x0))
     values = image[y0:y1, x0:x1][mask].astype(np.float64)

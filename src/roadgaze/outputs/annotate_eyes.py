@@ -8,6 +8,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.landmarks.eyes import EYES
 from roadgaze.types import EyeStatus, FrameRecord
 
 EYE_COLOURS_BGR = {
@@ -15,11 +16,6 @@ EYE_COLOURS_BGR = {
     EyeStatus.CLOSED: (40, 40, 235),
     EyeStatus.UNAVAILABLE: (150, 150, 150),
 }
-_CONTOURS = (
-    (33, 246, 161, 160, 159, 158, 157, 173, 133, 155, 154, 153, 145, 144, 163, 7),
-    (263, 466, 388, 387, 386, 385, 384, 398, 362, 382, 381, 380, 374, 373, 390, 249),
-)
-"""The eye openings (roadgaze.landmarks.eyes.EYES), kept here so outputs need no landmark code."""
 
 
 def draw_eyes(canvas: npt.NDArray[np.uint8], record: FrameRecord, scale: float) -> None:
@@ -35,8 +31,8 @@ def draw_eyes(canvas: npt.NDArray[np.uint8], record: FrameRecord, scale: float) 
     colour = EYE_COLOURS_BGR[eyes.status]
     points = features.landmarks_px[:, :2].astype(np.float64)
     centres = []
-    for contour in _CONTOURS:
-        outline = points[list(contour)]
+    for eye in EYES:
+        outline = points[list(eye.contour)]
         width = float(np.ptp(outline[:, 0]))
         pad = 0.25 * width
         x0, y0 = outline.min(axis=0) - pad

@@ -235,6 +235,18 @@ BLANK_FRAME = Frame(0, 0.0, np.zeros((4, 4, 3), np.uint8))
 """A frame for sinks that ignore the image."""
 
 
+FACE = FaceFeatures(
+    x_left_px=100.0,
+    x_right_px=180.0,
+    x_center_px=150.0,
+    roll_deg=10.0,
+    box_px=(95.0, 60.0, 185.0, 170.0),
+    quality=0.9,
+    landmarks_px=np.array([[100, 100, 0], [180, 110, 0], [150, 160, 0]], np.float32),
+)
+"""A face 80 px wide with its centre right of the middle (for writer and record tests)."""
+
+
 def record_of(
     sample: PoseSample, verdict: Verdict | None = None, alerts: tuple[Alert, ...] = ()
 ) -> FrameRecord:
@@ -243,3 +255,15 @@ def record_of(
         config = MonitorConfig()
         verdict = verdict_of(config, initial_state(config))
     return FrameRecord(sample=sample, verdict=verdict, alerts=alerts)
+
+
+def die_on_crash_drives(task: Any) -> Any:
+    """A fleet task function for worker processes: the process dies on drives named `crash*`
+    (as on a crash in native code); other drives succeed at once with one frame."""
+    import os
+
+    from roadgaze.fleet import DriveResult
+
+    if task.drive.drive_id.startswith("crash"):
+        os._exit(70)
+    return DriveResult.of(task.drive, "ok", frames=1, duration_s=0.1)

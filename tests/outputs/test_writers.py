@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
-from fakes import BLANK_FRAME, record_of
+from fakes import BLANK_FRAME, FACE, record_of
 from roadgaze.errors import RoadgazeError
 from roadgaze.outputs import (
     RECORD_FIELDS,
@@ -22,17 +22,8 @@ from roadgaze.outputs import (
     annotate,
     record_fields,
 )
-from roadgaze.types import Alert, AlertKind, AlertLevel, FaceFeatures, Frame, PoseSample
+from roadgaze.types import Alert, AlertKind, AlertLevel, Frame, PoseSample
 
-FACE = FaceFeatures(
-    x_left_px=100.0,
-    x_right_px=180.0,
-    x_center_px=150.0,
-    roll_deg=10.0,
-    box_px=(95.0, 60.0, 185.0, 170.0),
-    quality=0.9,
-    landmarks_px=np.array([[100, 100, 0], [180, 110, 0], [150, 160, 0]], np.float32),
-)
 WITH_FACE = PoseSample(0.5, 15, True, 20.25, 19.5, -3.0, 1.25, FACE, 1)
 WITHOUT_FACE = PoseSample(0.0, 0, False, None, None, None, None, None, 0)
 

@@ -3,6 +3,7 @@
 from types import ModuleType
 
 from roadgaze.commands import (
+    batch,
     bench,
     demo,
     estimate,
@@ -21,6 +22,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     run,
     listen,
     replay,
+    batch,
     bench,
     evaluate,
     estimate,

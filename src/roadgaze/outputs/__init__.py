@@ -5,10 +5,14 @@ from roadgaze.outputs.offline import fill_offline_columns
 from roadgaze.outputs.plots import YawPlot
 from roadgaze.outputs.progress import ProgressBar
 from roadgaze.outputs.records import (
+    ALERT_SCHEMA,
     OFFLINE_FIELDS,
     RECORD_FIELDS,
+    RECORD_SCHEMA,
     CsvWriter,
+    FieldType,
     JsonlWriter,
+    alert_fields,
     open_for_writing,
     record_fields,
     rounded,
@@ -16,14 +20,18 @@ from roadgaze.outputs.records import (
 from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
 
 __all__ = [
+    "ALERT_SCHEMA",
     "FOURCC_BY_SUFFIX",
     "OFFLINE_FIELDS",
     "RECORD_FIELDS",
+    "RECORD_SCHEMA",
     "AnnotatedVideoWriter",
     "CsvWriter",
+    "FieldType",
     "JsonlWriter",
     "ProgressBar",
     "YawPlot",
+    "alert_fields",
     "annotate",
     "fill_offline_columns",
     "open_for_writing",

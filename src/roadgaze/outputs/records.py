@@ -2,6 +2,8 @@
 
 `record_fields(record)` flattens a `FrameRecord` into the JSON-ready dict every writer uses:
 the pose sample's fields, then the monitor's verdict and the alerts raised on that frame.
+`RECORD_SCHEMA` types each of its fields (`alert_fields` and `ALERT_SCHEMA` do the same for one
+alert); columnar writers (the fleet's Parquet files) derive their schema from it.
 Every writer is a context manager and a pipeline sink (`on_record`, `close`).
 """
 
@@ -10,61 +12,93 @@ from __future__ import annotations
 import csv
 import json
 import math
+from enum import StrEnum
 from pathlib import Path
 from typing import IO, Any
 
 from roadgaze.errors import RoadgazeError
-from roadgaze.types import ClosesOnExit, EyesVerdict, Frame, FrameRecord
+from roadgaze.types import Alert, ClosesOnExit, EyesVerdict, Frame, FrameRecord
 
-RECORD_FIELDS = (
-    "t_s",
-    "frame",
-    "face",
-    "n_faces",
-    "yaw_raw_deg",
-    "yaw_deg",
-    "yaw_rate_dps",
-    "yaw_std_deg",
-    "pitch_raw_deg",
-    "pitch_deg",
-    "x_left",
-    "x_right",
-    "x_center",
-    "roll_deg",
-    "quality",
-    "on_road",
-    "gaze",
-    "zone",
-    "eyes_on_road",
-    "neutral_yaw_deg",
-    "neutral_pitch_deg",
-    "off_road_s",
-    "window_off_road_s",
-    "distraction_s",
-    "eyes",
-    "eyes_reason",
-    "eye_openness",
-    "eye_yaw_deg",
-    "eye_pitch_deg",
-    "gaze_yaw_deg",
-    "gaze_pitch_deg",
-    "gaze_source",
-    "closure_s",
-    "perclos",
-    "blinks",
-    "long_blinks",
-    "eyes_unavailable_s",
-    "degraded",
-    "alerts",
-    "yaw_offline_deg",
-    "pitch_offline_deg",
+
+class FieldType(StrEnum):
+    """The type of one field of a flat record; every field may also be None (null)."""
+
+    BOOL = "bool"
+    INT = "int"
+    FLOAT = "float"
+    STR = "str"
+    STR_LIST = "list[str]"
+
+
+RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
+    ("t_s", FieldType.FLOAT),
+    ("frame", FieldType.INT),
+    ("face", FieldType.BOOL),
+    ("n_faces", FieldType.INT),
+    ("yaw_raw_deg", FieldType.FLOAT),
+    ("yaw_deg", FieldType.FLOAT),
+    ("yaw_rate_dps", FieldType.FLOAT),
+    ("yaw_std_deg", FieldType.FLOAT),
+    ("pitch_raw_deg", FieldType.FLOAT),
+    ("pitch_deg", FieldType.FLOAT),
+    ("x_left", FieldType.FLOAT),
+    ("x_right", FieldType.FLOAT),
+    ("x_center", FieldType.FLOAT),
+    ("roll_deg", FieldType.FLOAT),
+    ("quality", FieldType.FLOAT),
+    ("on_road", FieldType.BOOL),
+    ("gaze", FieldType.STR),
+    ("zone", FieldType.STR),
+    ("eyes_on_road", FieldType.BOOL),
+    ("neutral_yaw_deg", FieldType.FLOAT),
+    ("neutral_pitch_deg", FieldType.FLOAT),
+    ("off_road_s", FieldType.FLOAT),
+    ("window_off_road_s", FieldType.FLOAT),
+    ("distraction_s", FieldType.FLOAT),
+    ("eyes", FieldType.STR),
+    ("eyes_reason", FieldType.STR),
+    ("eye_openness", FieldType.FLOAT),
+    ("eye_yaw_deg", FieldType.FLOAT),
+    ("eye_pitch_deg", FieldType.FLOAT),
+    ("gaze_yaw_deg", FieldType.FLOAT),
+    ("gaze_pitch_deg", FieldType.FLOAT),
+    ("gaze_source", FieldType.STR),
+    ("closure_s", FieldType.FLOAT),
+    ("perclos", FieldType.FLOAT),
+    ("blinks", FieldType.INT),
+    ("long_blinks", FieldType.INT),
+    ("eyes_unavailable_s", FieldType.FLOAT),
+    ("degraded", FieldType.BOOL),
+    ("alerts", FieldType.STR_LIST),
+    ("yaw_offline_deg", FieldType.FLOAT),
+    ("pitch_offline_deg", FieldType.FLOAT),
 )
-"""The fields of `record_fields`, in order (x_* in pixels of the roll-removed frame; the eye
-fields as `roadgaze.types.EyesVerdict` defines them, `eyes` is open, closed or unavailable).
-`yaw_offline_deg` / `pitch_offline_deg` are null while a replay streams; `fill_offline_columns`
-fills them at its end."""
+"""Every field of `record_fields`, in order, with its type: the one description the writers and
+the fleet's Parquet schema are derived from (x_* in pixels of the roll-removed frame; the eye
+fields as `roadgaze.types.EyesVerdict` defines them, `eyes` is open, closed or unavailable). A
+field added to `record_fields` is added here too (a test checks it)."""
+
+RECORD_FIELDS = tuple(name for name, _ in RECORD_SCHEMA)
+"""The fields of `record_fields`, in order. `yaw_offline_deg` / `pitch_offline_deg` are null
+while a replay streams; `fill_offline_columns` fills them at its end."""
 
 OFFLINE_FIELDS = ("yaw_offline_deg", "pitch_offline_deg")
+
+ALERT_SCHEMA: tuple[tuple[str, FieldType], ...] = (
+    ("kind", FieldType.STR),
+    ("level", FieldType.STR),
+    ("t_s", FieldType.FLOAT),
+    ("yaw_deg", FieldType.FLOAT),
+    ("off_road_s", FieldType.FLOAT),
+    ("window_off_road_s", FieldType.FLOAT),
+    ("unavailable_s", FieldType.FLOAT),
+    ("speed_kmh", FieldType.FLOAT),
+    ("clears", FieldType.STR_LIST),
+    ("closure_s", FieldType.FLOAT),
+    ("perclos", FieldType.FLOAT),
+    ("reason", FieldType.STR),
+)
+"""Every field of `alert_fields`: the content of an `AlertMessage` without its wire fields."""
 
 
 def rounded(value: float | None, digits: int) -> float | None:
@@ -110,8 +144,26 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
     }
 
 
+def alert_fields(alert: Alert) -> dict[str, Any]:
+    """One alert as a flat JSON-ready dict with the fields of `ALERT_SCHEMA`."""
+    return {
+        "kind": alert.kind.value,
+        "level": alert.level.value,
+        "t_s": round(alert.t_s, 6),
+        "yaw_deg": rounded(alert.yaw_deg, 3),
+        "off_road_s": round(max(0.0, alert.off_road_s), 3),
+        "window_off_road_s": round(max(0.0, alert.window_off_road_s), 3),
+        "unavailable_s": round(max(0.0, alert.unavailable_s), 3),
+        "speed_kmh": rounded(alert.speed_kmh, 3),
+        "clears": [kind.value for kind in alert.clears],
+        "closure_s": round(max(0.0, alert.closure_s), 3),
+        "perclos": rounded(alert.perclos, 4),
+        "reason": alert.reason,
+    }
+
+
 def eye_fields(eyes: EyesVerdict) -> dict[str, Any]:
-    """The eye part of the record (`eyes` ... `degraded` in RECORD_FIELDS)."""
+    """The eye part of the record (`eyes` ... `degraded` in RECORD_SCHEMA)."""
     return {
         "eyes": eyes.status.value,
         "eyes_reason": eyes.reason,

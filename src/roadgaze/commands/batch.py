@@ -1,0 +1,136 @@
+"""`roadgaze batch INPUT --out DIR`: replay a fleet's drives as Parquet, resumable, with a report.
+
+Exit status: 0 when every drive succeeded, 3 when some failed (listed on stderr), 2 for bad
+arguments (one line on stderr), 130 when stopped by Ctrl-C or SIGTERM (run it again to go on).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from roadgaze.commands.options import common_options
+from roadgaze.config import Config
+from roadgaze.errors import ConfigError
+
+if TYPE_CHECKING:
+    from roadgaze.fleet import BatchOutcome
+
+EXIT_SOME_FAILED = 3
+EXIT_INTERRUPTED = 130
+FAILED_LISTED = 20
+"""Failed drives named on stderr; the rest are in summary.parquet and report.html."""
+
+
+def register(subparsers: Any) -> None:
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        "batch",
+        parents=[common_options()],
+        help="replay many recorded drives to Parquet, resumable, with a fleet summary and report",
+        description="Run the pipeline over every video under a folder (searched recursively) or "
+        "listed in a CSV manifest (columns: path, and optionally drive_id, driver_id, "
+        "vehicle_id, start_time). Writes DIR/frames/<drive_id>.parquet, "
+        "DIR/alerts/<drive_id>.parquet, DIR/summary.parquet and DIR/report.html. A re-run skips "
+        "drives whose outputs match their input and configuration. Exit status 0 when all "
+        "drives succeeded, 3 when some failed, 2 for bad arguments, 130 when stopped.",
+    )
+    parser.add_argument(
+        "input", type=Path, metavar="INPUT", help="folder of videos or CSV manifest"
+    )
+    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
+    parser.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="local: worker processes (default: one per core); ray: drives in flight "
+        "(default: the cluster's CPUs)",
+    )
+    parser.add_argument(
+        "--engine", choices=["local", "ray"], default="local", help="where drives run"
+    )
+    parser.add_argument(
+        "--ray-address",
+        metavar="ADDR",
+        help="Ray cluster to use (e.g. 10.0.0.5:6379, ray://head:10001 or auto); default "
+        "RAY_ADDRESS, else a local Ray instance",
+    )
+    parser.add_argument(
+        "--hash",
+        action="store_true",
+        help="recognise unchanged inputs by their SHA-256 instead of size and modification time",
+    )
+    parser.add_argument(
+        "--retries",
+        type=int,
+        default=2,
+        metavar="N",
+        help="tries again when a worker process dies on a drive (default 2)",
+    )
+    parser.add_argument("--json", action="store_true", help="print the run's figures as JSON")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace, config: Config) -> int:
+    from roadgaze.fleet import BatchOptions, discover_drives, run_batch
+
+    if args.workers is not None and args.workers < 1:
+        raise ConfigError(f"--workers must be at least 1, found {args.workers}")
+    if args.retries < 0:
+        raise ConfigError(f"--retries must be 0 or more, found {args.retries}")
+    if args.ray_address is not None and args.engine != "ray":
+        raise ConfigError("--ray-address needs --engine ray")
+    if args.engine == "ray":
+        from roadgaze.fleet.engines import import_ray
+
+        import_ray()  # a missing Ray is a bad argument, said before any work
+    drives = discover_drives(args.input)
+    out_dir = args.out.resolve()
+    if out_dir.is_file():
+        raise ConfigError(f"--out {args.out} is a file; pass a folder")
+    options = BatchOptions(
+        out_dir=out_dir,
+        engine=args.engine,
+        workers=args.workers,
+        ray_address=args.ray_address,
+        content_hash=args.hash,
+        retries=args.retries,
+        progress=not args.no_progress,
+    )
+    outcome = run_batch(drives, config, options)
+    report(outcome, out_dir)
+    if args.json:
+        print(json.dumps(outcome.to_json()), flush=True)
+    if outcome.interrupted:
+        return EXIT_INTERRUPTED
+    return EXIT_SOME_FAILED if outcome.failed else 0
+
+
+def report(outcome: BatchOutcome, out_dir: Path) -> None:
+    """The closing lines on stderr: counts, pace, failed drives, where the outputs are."""
+    figures = outcome.to_json()
+    print(
+        f"batch: {figures['ok']} of {figures['drives']} drives ok ({figures['processed']} "
+        f"processed, {figures['resumed']} kept from an earlier run), {figures['failed']} failed; "
+        f"{figures['frames']} frames in {outcome.wall_s:.1f} s = {outcome.frames_per_s:.1f} "
+        f"frames/s on {outcome.engine} with {outcome.workers} "
+        f"worker{'' if outcome.workers == 1 else 's'}",
+        file=sys.stderr,
+    )
+    for result in outcome.failed[:FAILED_LISTED]:
+        print(f"batch: failed {result.drive_id} ({result.path}): {result.error}", file=sys.stderr)
+    if len(outcome.failed) > FAILED_LISTED:
+        more = len(outcome.failed) - FAILED_LISTED
+        print(f"batch: ... and {more} more failed (see the report)", file=sys.stderr)
+    if outcome.interrupted:
+        left = figures["interrupted"] + figures["pending"]
+        print(
+            f"batch: stopped; {left} drives not done; run the same command again to continue",
+            file=sys.stderr,
+        )
+    print(
+        f"batch: wrote {out_dir / 'summary.parquet'} and {out_dir / 'report.html'}", file=sys.stderr
+    )

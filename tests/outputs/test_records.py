@@ -1,0 +1,84 @@
+"""The typed description of the flat record: every field `record_fields` returns is described,
+with the type its values have, so columnar writers derived from it lose nothing."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+
+from fakes import FACE, record_of
+from roadgaze.outputs import (
+    ALERT_SCHEMA,
+    RECORD_FIELDS,
+    RECORD_SCHEMA,
+    FieldType,
+    alert_fields,
+    record_fields,
+)
+from roadgaze.transport import AlertMessage
+from roadgaze.types import Alert, AlertKind, AlertLevel, PoseSample
+
+ALERTS = (
+    Alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING, 0.5, 19.5, 3.0, 3.0),
+    Alert(
+        AlertKind.CLEARED,
+        AlertLevel.INFO,
+        4.0,
+        None,
+        3.5,
+        3.5,
+        unavailable_s=0.25,
+        speed_kmh=57.0,
+        clears=(AlertKind.LONG_DISTRACTION, AlertKind.VATS),
+    ),
+)
+RECORDS = (
+    record_of(PoseSample(0.5, 15, True, 20.25, 19.5, -3.0, 1.25, FACE, 1), alerts=ALERTS),
+    record_of(PoseSample(0.0, 0, False, None, None, None, None, None, 0)),
+)
+
+
+def has_type(value: Any, field_type: FieldType) -> bool:
+    if value is None:
+        return True
+    if field_type is FieldType.STR_LIST:
+        return isinstance(value, list) and all(isinstance(item, str) for item in value)
+    if field_type is FieldType.INT:
+        return isinstance(value, int) and not isinstance(value, bool)
+    if field_type is FieldType.FLOAT:
+        return isinstance(value, float)
+    expected = {FieldType.BOOL: bool, FieldType.STR: str}[field_type]
+    return isinstance(value, expected)
+
+
+@pytest.mark.parametrize("record", RECORDS, ids=["face-and-alerts", "no-face"])
+def test_every_field_of_the_flat_record_is_described_with_its_type(record: Any) -> None:
+    fields = record_fields(record)
+    undescribed = [name for name in fields if name not in RECORD_FIELDS]
+    assert undescribed == [], "add these fields to RECORD_SCHEMA in outputs/records.py"
+    assert tuple(fields) == RECORD_FIELDS
+    wrong = {
+        name: (fields[name], field_type.value)
+        for name, field_type in RECORD_SCHEMA
+        if not has_type(fields[name], field_type)
+    }
+    assert wrong == {}
+
+
+def test_the_described_types_are_what_a_face_frame_holds() -> None:
+    fields = record_fields(RECORDS[0])
+    assert fields["alerts"] == ["long_distraction:warning", "cleared:info"]
+    assert fields["gaze"] in {"on_road", "off_road", "unknown"}
+    assert all(fields[name] is not None for name in ("t_s", "frame", "face", "x_left", "quality"))
+
+
+@pytest.mark.parametrize("alert", ALERTS, ids=lambda a: a.kind.value)
+def test_alert_fields_are_the_alert_message_without_its_wire_fields(alert: Alert) -> None:
+    fields = alert_fields(alert)
+    assert tuple(fields) == tuple(name for name, _ in ALERT_SCHEMA)
+    assert all(has_type(fields[name], field_type) for name, field_type in ALERT_SCHEMA)
+    message = AlertMessage.from_alert(alert, "car-0", 0, 0.0).model_dump(mode="json")
+    wire_only = {"schema_id", "vehicle_id", "seq", "wall_time"}
+    assert set(message) - wire_only == set(fields)
+    assert {name: message[name] for name in fields} == fields

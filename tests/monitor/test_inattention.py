@@ -93,6 +93,7 @@ def test_long_distraction_fires_three_seconds_into_a_glance_then_clears() -> Non
     assert_within_one_frame(alerts[0].t_s, 7.0)
     assert alerts[0].off_road_s == pytest.approx(3.0, abs=FRAME_S)
     assert alerts[0].yaw_deg == AWAY_YAW_DEG
+    assert alerts[0].reason == "head in away"
     assert_within_one_frame(alerts[1].t_s, 8.0)
     assert alerts[1].clears == (AlertKind.LONG_DISTRACTION,)
     assert alerts[1].off_road_s == pytest.approx(4.0, abs=FRAME_S)

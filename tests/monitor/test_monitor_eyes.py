@@ -83,6 +83,7 @@ def test_an_eyes_only_glance_is_off_road(eye_yaw: float, eye_pitch: float, zone:
     else:
         assert kinds(alerts) == ["long_distraction:warning", "cleared:info"]
         assert near(alerts[0].t_s, 5.0) and near(alerts[1].t_s, 6.0)
+        assert alerts[0].reason == f"eyes in {zone}"  # the head stayed ahead: say so
     _, during = run(between(2.0, 6.0, glance), 4.0)
     assert during == []
     probe = Monitor(FIXED)

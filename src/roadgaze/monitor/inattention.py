@@ -96,6 +96,14 @@ class _Look:
     pitch_deg: float | None
     lost_since_s: float | None
     turned_away: bool
+    by_eyes: bool = False
+
+    @property
+    def why(self) -> str:
+        """Why the driver counts as off road, for the alert's `reason`."""
+        if self.turned_away:
+            return f"face out of view, last seen in {self.zone}"
+        return f"{'eyes' if self.by_eyes else 'head'} in {self.zone}"
 
 
 def _eyes_moved(eyes: EyesVerdict, head_yaw_deg: float, head_pitch_deg: float) -> bool:
@@ -130,6 +138,8 @@ def _classify(
                 (eyes.gaze_pitch_deg or 0.0) - state.neutral_pitch_deg,
                 state.face_zone,
             )
+            gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
+            return _Look(gaze, zone, zone, yaw, pitch, None, False, by_eyes=True)
         else:
             pitch_offset = 0.0 if pitch is None else pitch - state.neutral_pitch_deg
             zone = zones.classify(yaw - state.neutral_yaw_deg, pitch_offset, state.face_zone)
@@ -258,10 +268,10 @@ def step(
             distraction_now_s >= config.critical_distraction_s - EPS_S
             and long_level is not AlertLevel.CRITICAL
         ):
-            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.CRITICAL))
+            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.CRITICAL, reason=look.why))
             long_level = AlertLevel.CRITICAL
         elif distraction_now_s >= config.long_distraction_s - EPS_S and long_level is None:
-            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING))
+            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING, reason=look.why))
             long_level = AlertLevel.WARNING
 
     vats_armed = state.vats_armed

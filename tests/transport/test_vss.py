@@ -62,6 +62,16 @@ def test_keys_and_text() -> None:
     assert len(VSS_PATHS) == 11
 
 
+def test_angles_are_relative_to_the_neutral_and_wrapped() -> None:
+    monitor = MonitorConfig()
+    records = drive([(1.0, 0.0, eyes_of()), (1.0, -179.0, eyes_of())])
+    ahead = vss_values(records[0], monitor)
+    assert ahead["Vehicle.Occupant.Row1.DriverSide.HeadPosition.Yaw"] == -5.0  # neutral +5
+    assert ahead["Vehicle.Occupant.Row1.DriverSide.HeadPosition.Pitch"] == 0.0
+    turned = vss_values(records[-1], monitor)  # yaw -179 with the neutral at +5: wrapped
+    assert turned["Vehicle.Occupant.Row1.DriverSide.HeadPosition.Yaw"] == 176.0
+
+
 def test_levels_follow_their_closed_forms() -> None:
     records = drive(
         [(2.0, 5.0, eyes_of()), (2.0, 5.0, eyes_of(openness=0.05)), (2.0, -25.0, eyes_of())]

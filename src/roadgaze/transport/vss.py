@@ -87,9 +87,11 @@ def vss_text(value: VssValue) -> bytes:
 
 
 def _relative(value: float | None, neutral: float) -> float | None:
+    """`value - neutral` in degrees, wrapped into -180..180 (a full-range yaw of -179 with a
+    neutral of +5 is +176, not -184), rounded to 0.1; None when unknown."""
     if value is None or not math.isfinite(value):
         return None
-    return round(value - neutral, 1)
+    return round((value - neutral + 180.0) % 360.0 - 180.0, 1)
 
 
 def vss_values(record: FrameRecord, config: MonitorConfig) -> dict[str, VssValue]:

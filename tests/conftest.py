@@ -3,13 +3,25 @@ face turning to known yaws (no data needed). Paths live in `repo_paths`."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import logging
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from repo_paths import child_env
+
+
+@pytest.fixture
+def restore_logging() -> Iterator[None]:
+    """`main()` points roadgaze's log handler at the captured stderr; undo it afterwards."""
+    logger = logging.getLogger("roadgaze")
+    handlers, level, propagate = list(logger.handlers), logger.level, logger.propagate
+    yield
+    logger.handlers[:] = handlers
+    logger.setLevel(level)
+    logger.propagate = propagate
 
 
 @pytest.fixture

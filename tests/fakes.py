@@ -257,6 +257,39 @@ def record_of(
     return FrameRecord(sample=sample, verdict=verdict, alerts=alerts)
 
 
+def yaw_message(seq: int, yaw_deg: float = 10.0, vehicle_id: str = "test-car") -> YawMessage:
+    """A valid yaw message of one frame at 30 fps."""
+    return YawMessage(
+        vehicle_id=vehicle_id,
+        seq=seq,
+        t_s=seq / 30,
+        wall_time=time.time(),
+        frame=seq,
+        face=True,
+        yaw_deg=yaw_deg,
+        yaw_raw_deg=yaw_deg,
+        on_road=True,
+        gaze="on_road",
+        neutral_yaw_deg=0.0,
+        n_faces=1,
+    )
+
+
+def alert_message(seq: int = 0, vehicle_id: str = "test-car") -> AlertMessage:
+    """A valid long-distraction warning."""
+    return AlertMessage(
+        vehicle_id=vehicle_id,
+        seq=seq,
+        kind="long_distraction",
+        level="warning",
+        t_s=7.0,
+        wall_time=time.time(),
+        yaw_deg=45.0,
+        off_road_s=3.0,
+        window_off_road_s=3.0,
+    )
+
+
 def die_on_crash_drives(task: Any) -> Any:
     """A fleet task function for worker processes: the process dies on drives named `crash*`
     (as on a crash in native code); other drives succeed at once with one frame."""

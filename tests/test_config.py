@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from repo_paths import REPO
 from roadgaze.config import Config, load_config, parse_overrides
@@ -134,3 +137,39 @@ def test_shipped_default_config_mentions_every_field() -> None:
             assert f"{field} =" in text, (
                 f"config/roadgaze.toml does not mention {section_name}.{field}"
             )
+
+
+FIELDS = sorted(
+    f"{section}.{field}"
+    for section, model in Config.model_fields.items()
+    if model.annotation is not None
+    for field in model.annotation.model_fields
+)
+VALUE_TEXTS = (
+    st.sampled_from(["inf", "-inf", "nan", "true", "false", "''", "[]", "{}", "1e999", "-0"])
+    | st.integers().map(str)
+    | st.floats(allow_nan=True, allow_infinity=True).map(repr)
+    | st.integers(4000, 6000).map(lambda n: "9" * n)
+    | st.text(max_size=30)
+    | st.lists(st.integers(), max_size=3).map(str)
+)
+
+
+@settings(max_examples=250, deadline=None)
+@given(st.sampled_from(FIELDS), VALUE_TEXTS)
+def test_fuzz_any_value_in_any_field_is_a_config_error_or_a_finite_config(
+    field: str, text: str
+) -> None:
+    for origin in ("set", "env"):
+        try:
+            if origin == "set":
+                config = load_config(overrides={field: text}, environ={})
+            else:
+                name = "ROADGAZE__" + field.upper().replace(".", "__")
+                config = load_config(environ={name: text})
+        except ConfigError as exc:
+            assert "\n" not in str(exc) and len(str(exc)) < 1000
+            continue
+        for section in config.model_dump().values():
+            for value in section.values():
+                assert not isinstance(value, float) or math.isfinite(value)

@@ -289,12 +289,7 @@ def test_daemon_keeps_monitoring_while_the_peer_is_unreachable(glance_clip: Path
     port = free_port()
     daemon = run_daemon_process(str(glance_clip), port)
     try:
-        assert daemon.stderr is not None
-        started = LineReader(daemon, daemon.stderr)
-        line = ""
-        while "roadgaze run: source" not in line:
-            line = started.next(60.0) or ""
-            assert line or daemon.poll() is None, "daemon did not start"
+        LineReader(daemon, daemon.stderr).until("roadgaze run: source", 60.0)
         time.sleep(3.0)  # monitoring while nothing listens on the port
         assert daemon.poll() is None
         with router(port) as session:
@@ -433,3 +428,173 @@ def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
     assert back["status"] == "running" and back["problems"] == []
     # the final state is put at shutdown; it may reach the recorder just after run_daemon returns
     assert wait_for(lambda: any(s["status"] == "stopped" for s in recorder.of("state")), 5.0)
+
+
+# --- Faults on a daemon with a scripted camera and detector (tests/fake_daemon.py) -------------
+
+FAKE_DAEMON = Path(__file__).resolve().parent / "fake_daemon.py"
+
+
+def fake_daemon(vehicle_id: str, port: int, *extra: str) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [sys.executable, str(FAKE_DAEMON), *extra, "--vehicle-id", vehicle_id,
+         "--zenoh-connect", endpoint(port)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
+    )  # fmt: skip
+
+
+SIGNALS = [signal.SIGINT, signal.SIGTERM, signal.SIGHUP]
+BLOCK = zenoh.CongestionControl.BLOCK
+"""For test puts that must not be dropped by a busy machine (the default is DROP)."""
+
+
+@pytest.mark.parametrize("times", [1, 2], ids=["once", "twice"])
+@pytest.mark.parametrize("number", SIGNALS, ids=lambda n: signal.Signals(n).name)
+def test_signal_matrix(
+    number: int, times: int, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`roadgaze run` (in this process, scripted camera and detector): SIGINT, SIGTERM and
+    SIGHUP once finish the frame, put the final state and return 0; twice (during one long
+    frame) exit 1 without waiting. The subprocess form: the hostile-speed test below."""
+    import os
+    import threading
+
+    import roadgaze.capture
+    import roadgaze.pipeline
+    from fake_daemon import EndlessSource, GlancingDetector
+    from roadgaze.cli import main
+
+    frame_s = 0.05 if times == 1 else 1.5
+    monkeypatch.setattr(roadgaze.pipeline, "create_detector", lambda c: GlancingDetector(frame_s))
+    monkeypatch.setattr(roadgaze.capture, "open_source", lambda *a, **k: EndlessSource())
+    port = free_port()
+    name = signal.Signals(number).name
+    with router(port) as session:
+        hub = Hub(session, "sig")
+
+        def send() -> None:
+            assert wait_for(lambda: len(hub.of("yaw")) >= 1, timeout_s=30.0)
+            os.kill(os.getpid(), number)
+            if times == 2:
+                time.sleep(0.3)  # inside the same 1.5 s frame
+                os.kill(os.getpid(), number)
+
+        sender = threading.Thread(target=send, daemon=True)
+        sender.start()
+        started = time.monotonic()
+        args = ["run", "--source", "fake", "--vehicle-id", "sig", "--zenoh-connect",
+                endpoint(port)]  # fmt: skip
+        if times == 1:
+            code = main(args)
+        else:
+            with pytest.raises(SystemExit) as caught:
+                main(args)
+            code = int(caught.value.code or 0)
+        sender.join(timeout=30)
+        elapsed_s = time.monotonic() - started
+        time.sleep(0.5)
+        hub.close()
+    stderr = capsys.readouterr().err
+    assert f"{name} received" in stderr
+    if times == 1:
+        assert code == 0
+        assert f"stopping ({name})" in stderr
+        assert hub.of("state")[-1]["status"] == "stopped"
+    else:
+        assert code == 1
+        assert f"second {name}: exiting without waiting" in stderr
+        assert elapsed_s < 20.0
+
+
+def test_daemon_survives_hostile_speed_payloads_and_counts_them() -> None:
+    """Deep JSON, 10 MB, non-UTF-8, NaN and 1e308 km/h on the speed key: no traceback, the
+    oversize ones dropped unread and counted, the speed unknown (moving): alerts still fire."""
+    port = free_port()
+    with router(port) as session:
+        hub = Hub(session, "hostile")
+        daemon = fake_daemon("hostile", port)
+        try:
+            assert wait_for(lambda: hub.alive == [True], timeout_s=60.0)
+            hostile = [b"[" * 100_000, b"x" * 10_000_000, b"\xff\xfe", b"NaN", b"1e308",
+                       b'{"kmh": ' * 1000]  # fmt: skip
+            for _ in range(3):
+                for payload in hostile:
+                    session.put("vehicle/hostile/speed", payload, congestion_control=BLOCK)
+                    time.sleep(0.05)
+            assert wait_for(lambda: len(hub.of("alert")) >= 1, timeout_s=15.0)
+            state = hub.query_state()
+            daemon.send_signal(signal.SIGTERM)
+            code = daemon.wait(timeout=30)
+            stderr = daemon.stderr.read() if daemon.stderr else ""
+        finally:
+            stop_process(daemon)
+            hub.close()
+    assert code == 0 and "Traceback" not in stderr, stderr[-2000:]
+    assert state is not None
+    assert state["transport"]["speed_oversize"] >= 1
+    assert state["monitor"]["speed_source"] in ("invalid", "stale")
+    assert state["monitor"]["moving"] is True
+    assert hub.of("alert")[0]["kind"] == "long_distraction"
+    assert stderr.count("ignored speed message") <= 3  # rate-limited
+
+
+@pytest.mark.parametrize("vehicle_id", ["*", "", "car/1", "x" * 100_000])
+def test_run_refuses_a_vehicle_id_that_is_not_one_vehicle(
+    vehicle_id: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from roadgaze.cli import main
+
+    assert main(["run", "--source", "/dev/video97", "--vehicle-id", vehicle_id]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "--vehicle-id" in lines[0] and len(lines[0]) < 400, lines[:3]
+
+
+@pytest.mark.parametrize("with_router", [False, True], ids=["alone", "router-on-the-port"])
+def test_run_and_listen_without_endpoint_flags_find_each_other(with_router: bool) -> None:
+    """The documented default: both meet at the rendezvous endpoint (7447 in real use; a free
+    port here, set through the environment like a user's setting). `run` logs where it listens or
+    connects and says "connected" only once a consumer (or the router) really is."""
+    from contextlib import nullcontext
+
+    port = free_port()
+    env = ENV | {"ROADGAZE__ZENOH__RENDEZVOUS": endpoint(port)}
+    with router(port) if with_router else nullcontext():
+        daemon = subprocess.Popen(
+            [sys.executable, str(FAKE_DAEMON), "--vehicle-id", "meet"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+        )  # fmt: skip
+        listener: subprocess.Popen[str] | None = None
+        try:
+            daemon_log = LineReader(daemon, daemon.stderr)
+            lines = daemon_log.until("roadgaze run: source", 60.0)
+            time.sleep(1.0)
+            while (line := daemon_log.next(0.1)) is not None:
+                lines.append(line)
+            connected_alone = any("zenoh connected" in line for line in lines)
+            listener = subprocess.Popen(
+                [sys.executable, "-m", "roadgaze", "listen", "--no-yaw", "--count", "2",
+                 "--timeout", "30"],
+                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+            )  # fmt: skip
+            stdout, listen_log = listener.communicate(timeout=60)
+            daemon.send_signal(signal.SIGTERM)
+            assert daemon.wait(timeout=30) == 0
+            while (line := daemon_log.next(1.0)) is not None:
+                lines.append(line)
+        finally:
+            stop_process(daemon)
+            if listener is not None:
+                stop_process(listener)
+    printed = stdout.splitlines()
+    assert "alive  meet joined" in printed, stdout
+    assert any(line.startswith("ALERT  meet #0 long_distraction warning") for line in printed)
+    assert listener.returncode == 0, listen_log
+    assert f"connecting to {endpoint(port)}" in listen_log
+    daemon_text = "\n".join(lines)
+    if with_router:
+        assert f"connecting to {endpoint(port)}" in daemon_text
+        assert connected_alone and "zenoh connected: router" in daemon_text
+    else:
+        assert f"listening on {endpoint(port)}" in daemon_text
+        assert not connected_alone  # nobody there yet: no "connected"
+        assert "zenoh connected: client" in daemon_text

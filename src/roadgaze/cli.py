@@ -52,4 +52,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         # The reader of our stdout went away (e.g. `| head`): not an error of ours.
         sys.stderr.close()
         return 0
+    except OSError as exc:
+        # A full disk or a vanished folder while writing: outputs closed so far are kept.
+        where = f": {exc.filename}" if exc.filename else ""
+        print(f"roadgaze {args.command}: error: {exc.strerror or exc}{where}", file=sys.stderr)
+        return 2
     return code

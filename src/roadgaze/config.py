@@ -13,12 +13,16 @@ import os
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, Self
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from roadgaze.config_eyes import EyeMonitorSettings
 from roadgaze.config_eyes import EyesConfig as EyesConfig
+from roadgaze.config_section import Section as _Section
+from roadgaze.config_zenoh import VEHICLE_ID_PATTERN as VEHICLE_ID_PATTERN
+from roadgaze.config_zenoh import ZenohConfig as ZenohConfig
+from roadgaze.config_zenoh import check_key_template as check_key_template
 from roadgaze.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -26,10 +30,6 @@ if TYPE_CHECKING:
     from roadgaze.pose.geometry import FaceModelConstants
 
 ENV_PREFIX = "ROADGAZE__"
-
-
-class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 class ModelConfig(_Section):
@@ -254,30 +254,20 @@ class MonitorConfig(_Section, EyeMonitorSettings):
             driving_related=frozenset(self.driving_related_zones),
         )
 
-
-class ZenohConfig(_Section):
-    """Zenoh session and key expressions. Safe defaults: loopback only, no multicast scouting."""
-
-    mode: Literal["peer", "client"] = "peer"
-    connect: list[str] = Field(default_factory=list)
-    listen: list[str] = Field(default_factory=lambda: ["tcp/127.0.0.1:0"])
-    multicast_scouting: bool = False
-    config_file: Path | None = None
-    """A Zenoh JSON5 config file; when set it is the base and the fields above override it."""
-    vehicle_id: str = Field(default="car-0", pattern=r"^[A-Za-z0-9_.-]+$")
-    prefix: str = "vehicle/{vehicle_id}/dms"
-    speed_key: str = "vehicle/{vehicle_id}/speed"
-    """Key expression of the speed input; '' for none. Without a (fresh) speed: taken as moving."""
-    vss: bool = False
-    """Also publish the COVESA VSS driver signals (docs/zenoh.md), as `--vss` does."""
-    vss_prefix: str = Field(default="", pattern=r"^[^*$?#\s]*$")
-    """Key prefix of the VSS signals; '' publishes the bare VSS paths (one vehicle per network,
-    as Eclipse Kuksa assumes), e.g. 'car-0' gives car-0/Vehicle/Driver/IsEyesOnRoad."""
-    speed_stale_s: float = Field(default=5.0, gt=0)
-    """A speed older than this (wall time) is forgotten and the vehicle taken as moving again."""
-    reconnect_initial_s: float = Field(default=0.5, gt=0)
-    """First delay before re-opening a session that could not be opened (client mode)."""
-    reconnect_max_s: float = Field(default=10.0, gt=0)
+    @model_validator(mode="after")
+    def _thresholds_agree(self) -> Self:
+        """Refuse timings that contradict each other (each message names both fields)."""
+        if self.critical_distraction_s < self.long_distraction_s:
+            raise ValueError(
+                f"critical_distraction_s ({self.critical_distraction_s:g}) must not be below "
+                f"long_distraction_s ({self.long_distraction_s:g})"
+            )
+        if self.vats_threshold_s > self.vats_window_s:
+            raise ValueError(
+                f"vats_threshold_s ({self.vats_threshold_s:g}) must not exceed vats_window_s "
+                f"({self.vats_window_s:g})"
+            )
+        return self
 
 
 class LoggingConfig(_Section):
@@ -300,11 +290,16 @@ class Config(_Section):
     logging: LoggingConfig = LoggingConfig()
 
 
-def _parse_value(text: str) -> Any:
+def _parse_value(text: str, origin: str) -> Any:
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
         return text
+    except ValueError:  # an integer of more than 4300 digits
+        raise ConfigError(
+            f"{origin}: {text[:20]!r}... ({len(text)} characters) is not a usable value; "
+            "integers are limited to 4300 digits"
+        ) from None
 
 
 def _set_path(tree: dict[str, Any], dotted: str, value: Any, origin: str) -> None:
@@ -326,7 +321,13 @@ def _format_validation_error(error: ValidationError, origin: str) -> str:
     for item in error.errors():
         where = ".".join(str(p) for p in item["loc"])
         found = item.get("input")
-        problems.append(f"{where}: {item['msg']} (found {found!r})")
+        message = item["msg"] if len(item["msg"]) <= 300 else item["msg"][:300] + "..."
+        if isinstance(found, dict):  # a check across fields: the message names them
+            problems.append(f"{where}: {message}")
+            continue
+        text = repr(found)
+        text = text if len(text) <= 80 else f"{text[:60]}... ({len(text)} characters)"
+        problems.append(f"{where}: {message} (found {text})")
     return f"bad configuration from {origin}: " + "; ".join(problems)
 
 
@@ -351,15 +352,20 @@ def load_config(
             raise ConfigError(f"cannot read config file {path}: {exc}") from None
         except tomllib.TOMLDecodeError as exc:
             raise ConfigError(f"config file {path} is not valid TOML: {exc}") from None
+        except ValueError:  # an integer of more than 4300 digits
+            raise ConfigError(
+                f"config file {path}: a value is not usable; integers are limited to 4300 digits"
+            ) from None
         origins.append(str(path))
     env = os.environ if environ is None else environ
     for name, text in sorted(env.items()):
         if name.startswith(ENV_PREFIX):
             dotted = name.removeprefix(ENV_PREFIX).lower().replace("__", ".")
-            _set_path(tree, dotted, _parse_value(text), f"environment {name}")
+            origin = f"environment {name}"
+            _set_path(tree, dotted, _parse_value(text, origin), origin)
             origins.append(name)
     for dotted, text in (overrides or {}).items():
-        _set_path(tree, dotted, _parse_value(text), f"--set {dotted}")
+        _set_path(tree, dotted, _parse_value(text, f"--set {dotted}"), f"--set {dotted}")
         origins.append(f"--set {dotted}")
     try:
         return Config.model_validate(tree)

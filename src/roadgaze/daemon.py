@@ -2,9 +2,9 @@
 
 `bus_outputs` opens the Zenoh link (when publishing) with the `Health` sink answering its state
 queries and the `BusPublisher` sink; `roadgaze run`, `roadgaze replay --publish` and the demo use
-it. `run_daemon` adds the signal handlers and a source that waits for a camera, runs
-`Pipeline.run` until the source ends or a stop, publishes a final state, undeclares everything
-and returns 0.
+it. `run_daemon` adds the signal handlers (SIGINT, SIGTERM, SIGHUP) and a source that waits for
+a camera, runs `Pipeline.run` until the source ends or a stop, publishes a final state,
+undeclares everything and returns 0.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def bus_outputs(config: Config, source_label: str, publish: bool) -> Iterator[Bu
         health = Health(config, keys, None, source_label)
         yield BusOutputs(health=health, sinks=(health,), speed=no_speed, link=None)
         return
-    speed = SpeedInput(config.zenoh.speed_stale_s) if keys.speed is not None else None
+    speed = SpeedInput(config.zenoh.speed_timeout_s) if keys.speed is not None else None
     holder: list[Health] = []
     prefix = config.zenoh.vss_prefix
     link = ZenohLink(

@@ -110,7 +110,7 @@ class AlertSubscriber:
         alerts_path: Path,
         on_alert: Callable[[dict[str, Any]], None],
     ) -> None:
-        from roadgaze.transport import Keys, open_session
+        from roadgaze.transport import Keys, open_session, plan_session
 
         self.keys = Keys.from_config(config.zenoh)
         self._on_alert = on_alert
@@ -120,7 +120,7 @@ class AlertSubscriber:
         self._session: Any = None
         self._subscriber: Any = None
         try:
-            self._session = open_session(config.zenoh)
+            self._session = open_session(plan_session(config.zenoh, "consumer", mode="peer"))
             self._subscriber = self._session.declare_subscriber(self.keys.alert, self._on_sample)
         except BaseException:
             self.close()

@@ -1,4 +1,8 @@
-"""Signals: a stop flag the loop checks between frames, and SIGTERM handling for batch commands."""
+"""Signals: a stop flag the loop checks between frames, and SIGTERM handling for batch commands.
+
+SIGINT, SIGTERM and SIGHUP all mean "stop": a terminal closing (SIGHUP) must not kill the
+daemon without its final state.
+"""
 
 from __future__ import annotations
 
@@ -12,8 +16,11 @@ from types import FrameType
 log = logging.getLogger("roadgaze.daemon")
 
 
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
 class StopFlag:
-    """Set by SIGINT/SIGTERM (or a caller); the loop checks it between frames."""
+    """Set by SIGINT/SIGTERM/SIGHUP (or a caller); the loop checks it between frames."""
 
     def __init__(self) -> None:
         self._event = threading.Event()
@@ -31,20 +38,19 @@ class StopFlag:
 
 
 @contextmanager
-def signal_handlers(stop: StopFlag) -> Iterator[None]:
-    """SIGINT/SIGTERM set `stop` (the current frame is finished); a second one exits at once."""
+def signal_handlers(stop: StopFlag, doing: str = "finishing the current frame") -> Iterator[None]:
+    """SIGINT/SIGTERM/SIGHUP set `stop` (the current frame is finished); a second one exits at
+    once (exit code 1). `doing` says in the log what happens next."""
 
     def on_signal(number: int, frame: FrameType | None) -> None:
         name = signal.Signals(number).name
         if stop.is_set():
             log.warning("second %s: exiting without waiting", name)
             raise SystemExit(1)
-        log.info("%s received: finishing the current frame", name)
+        log.info("%s received: %s", name, doing)
         stop.set(name)
 
-    previous = {
-        number: signal.signal(number, on_signal) for number in (signal.SIGINT, signal.SIGTERM)
-    }
+    previous = {number: signal.signal(number, on_signal) for number in STOP_SIGNALS}
     try:
         yield
     finally:
@@ -54,7 +60,8 @@ def signal_handlers(stop: StopFlag) -> Iterator[None]:
 
 @contextmanager
 def sigterm_as_interrupt() -> Iterator[None]:
-    """Within the block, SIGTERM raises KeyboardInterrupt so `with` blocks close every output."""
+    """Within the block, SIGTERM and SIGHUP raise KeyboardInterrupt so `with` blocks close every
+    output."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -62,8 +69,9 @@ def sigterm_as_interrupt() -> Iterator[None]:
     def interrupt(signum: int, frame: object) -> None:
         raise KeyboardInterrupt(f"signal {signum}")
 
-    previous = signal.signal(signal.SIGTERM, interrupt)
+    previous = {number: signal.signal(number, interrupt) for number in STOP_SIGNALS[1:]}
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)

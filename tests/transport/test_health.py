@@ -140,10 +140,20 @@ def test_state_is_degraded_while_the_eyes_have_been_unavailable_ten_seconds() ->
 
 
 @pytest.mark.parametrize(
-    ("speed_payload", "expected"), [(b'{"kmh": 10}', 0), (b"50", 2), (None, 2)]
+    ("speed_payload", "expected", "source"),
+    [
+        (b'{"kmh": 10}', 0, "fresh"),
+        (b"50", 2, "fresh"),
+        (None, 2, "waiting"),
+        (b'{"kmh": 1e308}', 2, "invalid"),  # a spoofed absurd speed: unknown, i.e. moving
+        (b'{"kmh": -1}', 2, "invalid"),
+        (b"[" * 100_000, 2, "invalid"),
+    ],
 )
-def test_alerts_are_gated_on_the_speed_received(speed_payload: bytes | None, expected: int) -> None:
-    speed = SpeedInput(stale_s=5.0)
+def test_alerts_are_gated_on_the_speed_received(
+    speed_payload: bytes | None, expected: int, source: str
+) -> None:
+    speed = SpeedInput(timeout_s=5.0)
     if speed_payload is not None:
         speed.on_payload(speed_payload)
     link = FakeLink(speed=speed)
@@ -155,5 +165,5 @@ def test_alerts_are_gated_on_the_speed_received(speed_payload: bytes | None, exp
     assert len(link.alerts) == expected
     assert health.alerts_raised == expected
     state = health.state_message()
-    assert state.monitor.speed_source == ("waiting" if speed_payload is None else "fresh")
+    assert state.monitor.speed_source == source
     assert state.monitor.moving is (expected > 0)

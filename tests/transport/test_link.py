@@ -12,25 +12,23 @@ from typing import Any
 import jsonschema
 import pytest
 import zenoh
+from zenoh.ext import HistoryConfig, declare_advanced_subscriber
 
-from fakes import ListSource, ScriptedDetector
+from fakes import ListSource, ScriptedDetector, alert_message, yaw_message
 from repo_paths import child_env
 from roadgaze.config import Config, ZenohConfig
-from roadgaze.errors import TransportError
+from roadgaze.errors import ConfigError, TransportError
 from roadgaze.pipeline import Pipeline
 from roadgaze.transport import (
-    AlertMessage,
     BusPublisher,
     Health,
     Keys,
     SpeedInput,
     StateMessage,
-    YawMessage,
     ZenohLink,
     build_zenoh_config,
     json_schemas,
-    parse_speed_kmh,
-    session_config_dict,
+    plan_session,
 )
 from zenoh_helpers import (
     LineReader,
@@ -49,79 +47,11 @@ def link_config(port: int, **extra: Any) -> ZenohConfig:
     settings: dict[str, Any] = {
         "vehicle_id": "test-car",
         "connect": [endpoint(port)],
-        "listen": ["tcp/127.0.0.1:0"],
-        "reconnect_initial_s": 0.2,
-        "reconnect_max_s": 0.5,
     }
     return ZenohConfig.model_validate(settings | extra)
 
 
-def yaw_message(seq: int, yaw_deg: float = 10.0) -> YawMessage:
-    return YawMessage(
-        vehicle_id="test-car",
-        seq=seq,
-        t_s=seq / 30,
-        wall_time=time.time(),
-        frame=seq,
-        face=True,
-        yaw_deg=yaw_deg,
-        yaw_raw_deg=yaw_deg,
-        on_road=True,
-        gaze="on_road",
-        neutral_yaw_deg=0.0,
-        n_faces=1,
-    )
-
-
-def alert_message(seq: int = 0) -> AlertMessage:
-    return AlertMessage(
-        vehicle_id="test-car",
-        seq=seq,
-        kind="long_distraction",
-        level="warning",
-        t_s=7.0,
-        wall_time=time.time(),
-        yaw_deg=45.0,
-        off_road_s=3.0,
-        window_off_road_s=3.0,
-    )
-
-
-@pytest.mark.parametrize(
-    ("payload", "expected"),
-    [
-        (b'{"kmh": 42.5}', 42.5),
-        (b'{"kmh": 0}', 0.0),
-        (b"88", 88.0),
-        (b" 12.25 ", 12.25),
-    ],
-)
-def test_speed_payloads_accepted(payload: bytes, expected: float) -> None:
-    assert parse_speed_kmh(payload) == expected
-
-
-@pytest.mark.parametrize(
-    "payload",
-    [b"fast", b'{"mph": 30}', b'{"kmh": "30"}', b'{"kmh": true}', b"-5", b"[1]", b"\xff", b"NaN"],
-)
-def test_speed_payloads_rejected(payload: bytes) -> None:
-    with pytest.raises(ValueError):
-        parse_speed_kmh(payload)
-
-
-def test_speed_input_goes_stale() -> None:
-    now = [100.0]
-    speed = SpeedInput(stale_s=5.0, clock=lambda: now[0])
-    assert speed.current() == (None, "waiting")
-    speed.on_payload(b'{"kmh": 30}')
-    speed.on_payload(b"garbage")
-    assert speed.current() == (30.0, "fresh")
-    assert (speed.messages, speed.rejected) == (1, 1)
-    now[0] += 5.1
-    assert speed.current() == (None, "stale")
-
-
-def test_keys_and_safe_session_defaults() -> None:
+def test_keys_of_one_vehicle_and_of_all() -> None:
     config = ZenohConfig()
     keys = Keys.from_config(config, "car-7")
     assert (keys.yaw, keys.alert, keys.alive, keys.state, keys.speed) == (
@@ -131,30 +61,42 @@ def test_keys_and_safe_session_defaults() -> None:
         "vehicle/car-7/dms/state",
         "vehicle/car-7/speed",
     )
+    assert keys.advanced == "vehicle/car-7/dms/*/@adv/**"
     assert Keys.from_config(config.model_copy(update={"speed_key": ""})).speed is None
-    settings = session_config_dict(config)
-    assert settings == {
-        "mode": "peer",
-        "listen/endpoints": ["tcp/127.0.0.1:0"],
-        "scouting/multicast/enabled": False,
-    }
+    assert Keys.matching(config, None).alert == "vehicle/*/dms/alert"
+    assert Keys.matching(config, "*").state == "vehicle/*/dms/state"
+
+
+@pytest.mark.parametrize("vehicle_id", ["*", "", "**", "a/b", "car 1", "$*", "car.1", "x" * 65])
+def test_a_daemon_refuses_vehicle_ids_that_are_not_one_vehicle(vehicle_id: str) -> None:
+    with pytest.raises(ConfigError, match="vehicle id must be 1-64"):
+        Keys.from_config(ZenohConfig(), vehicle_id)
 
 
 def test_bad_session_settings_are_one_line_errors(tmp_path: Path) -> None:
-    with pytest.raises(TransportError, match="client mode needs a router"):
-        build_zenoh_config(ZenohConfig(mode="client"))
+    with pytest.raises(TransportError, match="client needs a router"):
+        build_zenoh_config(plan_session(ZenohConfig(mode="client", rendezvous="")))
     with pytest.raises(TransportError, match="not found"):
-        build_zenoh_config(ZenohConfig(config_file=tmp_path / "missing.json5"))
-    with pytest.raises(TransportError, match="placeholder"):
-        Keys.from_config(ZenohConfig(prefix="vehicle/{car}/dms"))
+        build_zenoh_config(plan_session(ZenohConfig(config_file=tmp_path / "missing.json5")))
+    with pytest.raises(TransportError, match="bad zenoh configuration"):
+        build_zenoh_config(plan_session(ZenohConfig(connect=["nonsense"])))
 
 
 def test_config_file_is_the_base_and_explicit_fields_override(tmp_path: Path) -> None:
     path = tmp_path / "zenoh.json5"
-    path.write_text('{ mode: "peer", listen: { endpoints: ["tcp/127.0.0.1:0"] } }')
+    path.write_text(
+        '{ mode: "peer", listen: { endpoints: [] }, '
+        'connect: { endpoints: ["tcp/127.0.0.1:7999"] } }'
+    )
     config = ZenohConfig.model_validate({"config_file": path, "multicast_scouting": False})
-    assert session_config_dict(config) == {"scouting/multicast/enabled": False}
-    build_zenoh_config(config)  # parses
+    plan = plan_session(config, probe=lambda endpoint: pytest.fail("no rendezvous with a file"))
+    assert plan.settings == {"scouting/multicast/enabled": False}
+    _, resolved = build_zenoh_config(plan)  # parses; endpoints read back from the file
+    assert (resolved.mode, resolved.connect, resolved.listen) == (
+        "peer",
+        ("tcp/127.0.0.1:7999",),
+        (),
+    )
 
 
 def test_schemas_validate_the_messages() -> None:
@@ -214,8 +156,11 @@ def test_subscriber_in_another_process_receives_valid_yaw_and_alert() -> None:
             gone = reader.next(10.0)
             while gone is not None and json.loads(gone)["type"] != "alive":
                 gone = reader.next(10.0)
+            listener.terminate()  # SIGTERM: a clean stop, exit 0
+            code = listener.wait(timeout=10)
         finally:
             stop_process(listener)
+    assert code == 0
     yaw, alert = received[0]["payload"], received[-1]["payload"]
     jsonschema.validate(yaw, SCHEMAS["yaw"])
     jsonschema.validate(alert, SCHEMAS["alert"])
@@ -261,9 +206,9 @@ def test_state_query_answers_the_current_state() -> None:
         health_holder.append(health)
         publisher = BusPublisher(keys.vehicle_id, link)
         pipeline = Pipeline.from_config(config, ScriptedDetector([40.0] * 5))
+        assert wait_for(lambda: link.status().connected)
         pipeline.run(ListSource(5), [health, publisher])
         with client(port) as asker:
-            assert wait_for(lambda: link.status().connected)
             replies = list(asker.get(keys.state, timeout=5.0))
     answers = [reply.ok for reply in replies if reply.ok is not None]
     assert len(answers) == 1
@@ -275,6 +220,8 @@ def test_state_query_answers_the_current_state() -> None:
     assert state.monitor.gaze == "off_road" and state.monitor.on_road is False
     assert state.monitor.off_road_s == pytest.approx(4 / 30)
     assert state.transport.yaw_sent == 5 and state.transport.connected
+    assert (state.transport.routers, state.transport.connect) == (1, [endpoint(port)])
+    assert state.transport.alert_cache_size == 100 and state.transport.listen == []
     assert state.config["monitor"]["long_distraction_s"] == 3.0
     assert state.config["keys"]["alert"] == "vehicle/test-car/dms/alert"
 
@@ -283,19 +230,28 @@ def test_speed_input_from_zenoh() -> None:
     port = free_port()
     config = link_config(port)
     keys = Keys.from_config(config)
-    speed = SpeedInput(stale_s=5.0)
+    speed = SpeedInput(timeout_s=5.0)
     with router(port) as hub, ZenohLink(config, keys, speed=speed):
         assert keys.speed == "vehicle/test-car/speed"
         for _ in range(100):  # until the speed subscription has propagated
             hub.put(keys.speed, b'{"kmh": 57.5}')
-            if speed.messages:
+            if speed.kmh() is not None:  # the frame loop takes the newest payload
                 break
             time.sleep(0.1)
         assert speed.current() == (57.5, "fresh")
-        hub.put(keys.speed, b"not a speed")
-        assert wait_for(lambda: speed.rejected == 1)
-        hub.put(keys.speed, b"12")
-        assert wait_for(lambda: speed.current() == (12.0, "fresh"))
+
+        def taken(payload: bytes) -> bool:
+            hub.put(keys.speed, payload)
+            time.sleep(0.05)
+            speed.kmh()
+            return True
+
+        taken(b"not a speed")
+        assert speed.rejected == 1 and speed.current() == (None, "invalid")  # fail-safe
+        taken(b"x" * 10_000)
+        assert speed.oversize == 1
+        taken(b"12")
+        assert speed.current() == (12.0, "fresh")
 
 
 def test_unreachable_router_degrades_then_recovers_and_delivers_kept_alerts() -> None:
@@ -312,8 +268,11 @@ def test_unreachable_router_degrades_then_recovers_and_delivers_kept_alerts() ->
         assert link.status().pending_alerts == 1 and link.status().not_sent == 1
         received: list[bytes] = []
         with router(port) as hub:
-            subscriber = hub.declare_subscriber(
-                keys.alert, lambda sample: received.append(sample.payload.to_bytes())
+            subscriber = declare_advanced_subscriber(
+                hub,
+                keys.alert,
+                lambda sample: received.append(sample.payload.to_bytes()),
+                history=HistoryConfig(detect_late_publishers=True),
             )
             assert wait_for(lambda: link.status().connected, timeout_s=15.0)
             assert wait_for(lambda: len(received) == 1, timeout_s=5.0)

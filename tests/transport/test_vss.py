@@ -15,7 +15,16 @@ from fakes import BLANK_FRAME, eyes_of
 from repo_paths import child_env
 from roadgaze.config import Config, MonitorConfig
 from roadgaze.monitor import Monitor
-from roadgaze.transport import Keys, VssPublisher, ZenohLink, vss_key, vss_text, vss_values
+from roadgaze.transport import (
+    Keys,
+    PayloadError,
+    VssPublisher,
+    ZenohLink,
+    parse_vss_text,
+    vss_key,
+    vss_text,
+    vss_values,
+)
 from roadgaze.transport.vss import VSS_PATHS
 from roadgaze.types import EyesFeatures, EyeStatus, EyesVerdict, FrameRecord, PoseSample
 from zenoh_helpers import LineReader, endpoint, free_port, router, stop_process, wait_for
@@ -60,6 +69,46 @@ def test_keys_and_text() -> None:
         b"0.0",
     )
     assert len(VSS_PATHS) == 11
+
+
+@pytest.mark.parametrize(
+    ("key", "raw", "prefix", "expected"),
+    [
+        ("Vehicle/Driver/IsEyesOnRoad", b"true", "", "true"),
+        ("car-0/Vehicle/ADAS/DMS/IsError", b"false", "car-0", "false"),
+        ("Vehicle/Driver/FatigueLevel", b"100.0", "", "100.0"),
+        ("Vehicle/Occupant/Row1/DriverSide/HeadPosition/Yaw", b"-12.5", "", "-12.5"),
+        ("Vehicle/Speed", b"57.5", "", "57.5"),  # not roadgaze's: short printable text
+        ("Vehicle/Driver/IsEyesOnRoad", b"True", "", "true or false"),
+        ("Vehicle/Driver/FatigueLevel", b"100.1", "", "outside 0..100"),
+        ("Vehicle/Driver/DistractionLevel", b"-0.5", "", "outside 0..100"),
+        ("Vehicle/Driver/AttentiveProbability", b"nan", "", "decimal number"),
+        ("Vehicle/Driver/AttentiveProbability", b"1e3", "", "decimal number"),
+        ("Vehicle/Occupant/Row1/DriverSide/MidEyeGaze/Elevation", b"95.0", "", "outside -90..90"),
+        ("Vehicle/Occupant/Row1/DriverSide/HeadPosition/Roll", b" 5", "", "decimal number"),
+        ("Vehicle/Driver/FatigueLevel", b"\xff", "", "not UTF-8"),
+        ("Vehicle/Cabin/Note", b"\x1b[2J", "", "printable"),
+        ("Vehicle/Cabin/Note", b"x" * 300, "", "limit 256"),
+    ],
+)
+def test_vss_values_from_the_bus_are_checked(
+    key: str, raw: bytes, prefix: str, expected: str
+) -> None:
+    if expected in ("true", "false", "100.0", "-12.5", "57.5"):
+        assert parse_vss_text(key, raw, prefix) == expected
+    else:
+        with pytest.raises(PayloadError, match=expected):
+            parse_vss_text(key, raw, prefix)
+
+
+def test_what_roadgaze_publishes_passes_its_own_check() -> None:
+    monitor = MonitorConfig()
+    records = drive([(1.0, 0.0, eyes_of()), (1.0, 40.0, None), (1.0, -179.0, eyes_of())])
+    for record in records:
+        for path, value in vss_values(record, monitor).items():
+            assert parse_vss_text(vss_key(path), vss_text(value)) == vss_text(value).decode()
+    turned = vss_values(records[-1], monitor)  # yaw -179 with the neutral at +5: wrapped
+    assert turned["Vehicle.Occupant.Row1.DriverSide.HeadPosition.Yaw"] == 176.0
 
 
 def test_angles_are_relative_to_the_neutral_and_wrapped() -> None:

@@ -14,6 +14,7 @@ from roadgaze.commands import (
     replay,
     run,
     schema,
+    security,
     synth,
 )
 
@@ -29,6 +30,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     synth,
     model,
     schema,
+    security,
     paper,
 )
 """Each module has `register(subparsers)`, which adds its parser and sets `handler(args, config)`.

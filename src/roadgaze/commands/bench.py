@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from roadgaze.commands.options import common_options
+from roadgaze.commands.options import check_seconds, common_options
 from roadgaze.config import Config
 from roadgaze.types import Frame, FrameRecord
 
@@ -94,8 +94,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
 
     if args.warmup < 0:
         raise ConfigError(f"--warmup must be >= 0, found {args.warmup}")
-    if args.loop_seconds is not None and args.loop_seconds <= 0:
-        raise ConfigError(f"--loop-seconds must be > 0, found {args.loop_seconds}")
+    check_seconds("--loop-seconds", args.loop_seconds)
     rss_start_mb = resident_mb()
     source: FrameSource
     if args.loop_seconds is not None:

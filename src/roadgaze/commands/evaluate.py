@@ -8,7 +8,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from roadgaze.commands.options import common_options
+from roadgaze.commands.options import PLOT_SUFFIXES, check_output_paths, common_options
 from roadgaze.config import Config
 
 
@@ -59,6 +59,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace, config: Config) -> int:
     from dataclasses import replace
 
+    from roadgaze.errors import DatasetError
     from roadgaze.evaluation import (
         compare_landmark_choices,
         estimate_images,
@@ -74,7 +75,22 @@ def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.landmarks import CANDIDATE_CHOICES
     from roadgaze.landmarks.model_store import resolve_model
 
+    check_output_paths(
+        {"DATASET_DIR": args.dataset, "ground_truth.csv": args.dataset / "ground_truth.csv"},
+        {
+            "--report": args.report,
+            "--predictions": args.predictions,
+            "--plot": args.plot,
+            "--compare-landmarks": args.compare_landmarks,
+        },
+        {"--plot": PLOT_SUFFIXES},
+    )
     truths, skipped = load_ground_truth(args.dataset)
+    if not any((args.dataset / truth.file).is_file() for truth in truths):
+        raise DatasetError(
+            f"none of the {len(truths)} images listed in {args.dataset / 'ground_truth.csv'} "
+            f"exists under {args.dataset} (first: {truths[0].file}); check the folder"
+        )
     constants = config.geometry.face_constants()
     model_path = resolve_model(config.model)
     jobs = [(args.dataset / truth.file, truth.file) for truth in truths]

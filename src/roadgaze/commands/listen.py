@@ -1,16 +1,38 @@
-"""`roadgaze listen`: print what a Zenoh subscriber receives from roadgaze daemons."""
+"""`roadgaze listen`: print what a Zenoh subscriber receives from roadgaze daemons, checked.
+
+Alerts come through Zenoh's advanced subscriber (history: the last alerts when it joins or when
+a daemon appears; recovery: alerts missed during a link outage), so every alert is printed once,
+in `seq` order. Every message is checked (`MessageChecker`) before it is printed; rejected ones
+are reported on stderr. By default `listen` is a client of the rendezvous endpoint
+(tcp/127.0.0.1:7447), where `roadgaze run` listens or a router runs.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import logging
+import math
 import queue
 import sys
 import time
 from typing import Any
 
-from roadgaze.commands.options import add_zenoh_options, common_options, zenoh_config_from_args
+from roadgaze.commands.listen_lines import format_pretty as format_pretty
+from roadgaze.commands.listen_lines import format_vss as format_vss
+from roadgaze.commands.options import (
+    add_zenoh_options,
+    check_seconds,
+    common_options,
+    zenoh_config_from_args,
+)
 from roadgaze.config import Config
+from roadgaze.transport.checks import vehicle_of
+
+log = logging.getLogger("roadgaze.listen")
+QUEUE_SIZE = 10_000
+VSS_MAX_BYTES = 256
+"""A VSS value is a short text; anything longer is refused unread."""
 
 
 def register(subparsers: Any) -> None:
@@ -20,11 +42,15 @@ def register(subparsers: Any) -> None:
         help="print the yaw, alert, state and liveliness messages of one vehicle (or all), and "
         "with --vss the COVESA VSS signals",
         description="Subscribe to vehicle/<id>/dms/{yaw,alert,state} and the liveliness token "
-        "vehicle/<id>/dms/alive, and print each message: readable lines, or one JSON object per "
-        "line with --json. Without --vehicle-id every vehicle is shown. With --query-state, ask "
-        "the state queryable once, print the answers and exit: 0 when every answer says running, "
-        "3 when one is degraded (or starting/stopping), 1 without an answer (a health check). "
-        "With --vss, also the COVESA VSS driver signals (Vehicle/**, under zenoh.vss_prefix).",
+        "vehicle/<id>/dms/alive and print each checked message: readable lines, or one JSON "
+        "object per line with --json. Without --vehicle-id (or with '*') every vehicle is shown. "
+        "Alerts arrive complete and in order (history and recovery from the daemon's cache). "
+        "By default listen connects as a client to zenoh.rendezvous (tcp/127.0.0.1:7447). "
+        "--timeout S exits 1 when nothing was connected or received in S seconds. With "
+        "--query-state, ask the state queryable once, print the answers and exit: 0 when every "
+        "answer says running, 3 when one is degraded (or starting/stopping) or a vehicle "
+        "answered twice, 1 without an answer (a health check). With --vss, also the COVESA VSS "
+        "driver signals (Vehicle/**, under zenoh.vss_prefix), each value checked.",
     )
     add_zenoh_options(parser)
     parser.add_argument("--json", action="store_true", help="one JSON object per line")
@@ -35,186 +61,300 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def _kind_of(key: str) -> str:
-    return key.rsplit("/", 1)[-1]
-
-
 def _vehicle_of(key: str, prefix_template: str) -> str:
-    parts = prefix_template.strip("/").split("/")
-    if "{vehicle_id}" in parts:
-        index = parts.index("{vehicle_id}")
-        key_parts = key.split("/")
-        if index < len(key_parts):
-            return key_parts[index]
-    return "?"
+    return vehicle_of(key, prefix_template)
 
 
-def format_pretty(kind: str, vehicle: str, payload: dict[str, Any] | None, raw: str) -> str:
-    """One readable line for a received message."""
-    if payload is None:
-        return f"{kind:<6} {vehicle} undecodable payload: {raw[:120]}"
-    if kind == "alive":
-        return f"alive  {vehicle} {'joined' if payload.get('alive') else 'left'}"
-    if kind == "alert":
-        yaw = payload.get("yaw_deg")
-        yaw_text = "no face" if yaw is None else f"yaw={yaw:+.1f}°"
-        text = (
-            f"ALERT  {vehicle} #{payload.get('seq')} {payload.get('kind')} "
-            f"{payload.get('level')} t={payload.get('t_s', 0.0):.2f}s "
-            f"off_road={payload.get('off_road_s', 0.0):.2f}s "
-            f"window={payload.get('window_off_road_s', 0.0):.2f}s {yaw_text}"
-        )
-        if payload.get("clears"):
-            text += " clears=" + ",".join(payload["clears"])
-        if payload.get("closure_s"):
-            text += f" closure={payload['closure_s']:.2f}s"
-        if payload.get("reason"):
-            text += f" ({payload['reason']})"
-        return text
-    if kind == "yaw":
-        yaw = payload.get("yaw_deg")
-        yaw_text = "    --  " if yaw is None else f"{yaw:+7.1f}°"
-        line = f"yaw    {vehicle} #{payload.get('seq')} t={payload.get('t_s', 0.0):.2f}s {yaw_text}"
-        if "zone" not in payload:  # roadgaze.yaw/1
-            return f"{line} {payload.get('gaze')}"
-        pitch = payload.get("pitch_deg")
-        pitch_text = "    --  " if pitch is None else f"{pitch:+7.1f}°"
-        line = f"{line} pitch {pitch_text} {payload.get('zone') or payload.get('gaze')}"
-        if "eyes" not in payload:  # roadgaze.yaw/2
-            return line
-        return f"{line} {_eyes_text(payload)}"
-    if kind == "state":
-        transport = payload.get("transport", {})
-        return (
-            f"state  {vehicle} status={payload.get('status')} frames={payload.get('frames')} "
-            f"alerts_sent={transport.get('alerts_sent')} problems={payload.get('problems')}"
-        )
-    return f"{kind:<6} {vehicle} {raw[:200]}"
-
-
-def _eyes_text(payload: dict[str, Any]) -> str:
-    """The eyes of a yaw/3 message in a few words: state, openness, gaze, closure, PERCLOS."""
-    eyes = str(payload.get("eyes"))
-    openness = payload.get("eye_openness")
-    text = f"eyes {eyes}" + ("" if openness is None else f" {openness:.2f}")
-    gaze = payload.get("gaze_yaw_deg")
-    if gaze is not None and payload.get("gaze_source") == "eyes":
-        text += f" gaze {gaze:+.1f}°/{payload.get('gaze_pitch_deg') or 0.0:+.1f}°"
-    if payload.get("closure_s"):
-        text += f" closed {payload['closure_s']:.1f}s"
-    if payload.get("perclos") is not None:
-        text += f" perclos {payload['perclos']:.2f}"
-    if payload.get("degraded"):
-        text += " DEGRADED"
-    return text
-
-
-def format_vss(key: str, raw: bytes) -> str:
-    """One readable line for a VSS value: `vss    Vehicle/Driver/IsEyesOnRoad = true`."""
-    return f"vss    {key} = {raw.decode('utf-8', errors='replace')[:60]}"
-
-
-def _decode(raw: bytes) -> tuple[dict[str, Any] | None, str]:
-    text = raw.decode("utf-8", errors="replace")
-    try:
-        value = json.loads(text)
-    except json.JSONDecodeError:
-        return None, text
-    return (value if isinstance(value, dict) else None), text
+def _say(text: str) -> None:
+    print(f"roadgaze listen: {text}", file=sys.stderr, flush=True)
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
-    import zenoh
+    from roadgaze.errors import TransportError
+    from roadgaze.signals import StopFlag, signal_handlers
+    from roadgaze.transport import Keys, build_zenoh_config, open_session, plan_session
 
-    from roadgaze.transport import Keys, open_session, vss_key
-
-    zconf = zenoh_config_from_args(config.zenoh, args)
-    keys = Keys.from_config(zconf, args.vehicle_id or "*")
-    deadline = None if args.timeout is None else time.monotonic() + args.timeout
-    received: queue.Queue[tuple[str, str, bytes]] = queue.Queue(maxsize=10_000)
-    dropped = 0
-
-    def emit(kind: str, key: str, payload: bytes) -> None:
-        nonlocal dropped
+    # Non-UTF-8 text (a lone surrogate in a hostile payload) is escaped, never a crash.
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is not None:
+            reconfigure(errors="backslashreplace")
+    check_seconds("--timeout", args.timeout)
+    all_vehicles = args.vehicle_id in (None, "*")
+    zconf = zenoh_config_from_args(
+        config.zenoh, argparse.Namespace(**{**vars(args), "vehicle_id": None})
+    )
+    keys = Keys.matching(zconf, None if all_vehicles else args.vehicle_id)
+    plan = plan_session(zconf, "consumer", mode=args.zenoh_mode)
+    plan = build_zenoh_config(plan)[1]  # endpoints as the session will use them
+    endpoints = ", ".join(plan.connect + plan.listen) or "no endpoint"
+    timeout_s = args.timeout if args.timeout is not None else 5.0 if args.query_state else None
+    stop = StopFlag()
+    with signal_handlers(stop, doing="stopping"):
+        started = time.monotonic()
+        log.info("roadgaze listen: %s; keys %s/*", plan.describe(), keys.prefix)
+        if all_vehicles and plan.config_file is not None:
+            log.warning(
+                "roadgaze listen: with access control (roadgaze security init) a subscription "
+                "to every vehicle is denied: name the vehicle with --vehicle-id"
+            )
         try:
-            received.put_nowait((kind, key, payload))
-        except queue.Full:
-            dropped += 1
+            session = open_session(
+                plan, wait_s=math.inf if timeout_s is None else timeout_s, stopped=stop.is_set
+            )
+        except TransportError:
+            if stop.is_set():
+                return 0
+            if timeout_s is None:
+                raise
+            _say(
+                f"connected to nothing ({endpoints}) in {timeout_s:g} s: is `roadgaze run` "
+                "or a router up?"
+            )
+            return 1
+        with session:
+            listener = _Listener(args, zconf.prefix, keys, session, zconf.alert_cache_size)
+            if zconf.vss:
+                listener.vss_prefix = zconf.vss_prefix
+            remaining_s = None if timeout_s is None else timeout_s - (time.monotonic() - started)
+            try:
+                if args.query_state:
+                    return listener.query_state(max(0.5, remaining_s or 0.0))
+                return listener.follow(remaining_s, stop, endpoints)
+            finally:
+                listener.close()
 
-    def print_line(kind: str, key: str, raw: bytes) -> None:
-        if kind == "vss":
-            if args.json:
-                text = raw.decode("utf-8", errors="replace")
-                print(json.dumps({"type": "vss", "key": key, "value": text}), flush=True)
+
+class _Listener:
+    """The subscriptions of one `listen` run and the printing of what they receive."""
+
+    def __init__(
+        self, args: argparse.Namespace, prefix_template: str, keys: Any, session: Any, history: int
+    ) -> None:
+        import zenoh
+
+        from roadgaze.transport import MESSAGE_MAX_BYTES, ThrottledWarning
+        from roadgaze.transport.checks import MessageChecker
+
+        self.args = args
+        self.keys = keys
+        self.session = session
+        self.prefix_template = prefix_template
+        self.history = history
+        self.checker = MessageChecker(prefix_template)
+        self.max_bytes = MESSAGE_MAX_BYTES
+        self.received: queue.Queue[tuple[str, str, bytes | int, str | None]] = queue.Queue(
+            QUEUE_SIZE
+        )
+        self.dropped = 0
+        self.connected: set[str] = set()
+        self.ever_connected = False
+        self.warn = ThrottledWarning(log, "roadgaze listen: message rejected", period_s=5.0)
+        self.vss_prefix: str | None = None
+        """With --vss: the prefix of the VSS keys ('' for the bare paths); None: not shown."""
+        self._sample_kind_put = zenoh.SampleKind.PUT
+        self.entities: list[Any] = [
+            session.info.declare_transport_events_listener(self._on_transport, history=True)
+        ]
+
+    def _on_transport(self, event: Any) -> None:
+        zid = str(event.transport.zid)
+        whatami = str(event.transport.whatami).rsplit(".", 1)[-1].lower()
+        if event.kind == self._sample_kind_put:
+            self.connected.add(zid)
+            self.ever_connected = True
+            log.info("roadgaze listen: connected to %s %s", whatami, zid)
+        else:
+            self.connected.discard(zid)
+            log.warning("roadgaze listen: %s %s gone; waiting for it to come back", whatami, zid)
+
+    def _emit(self, kind: str, key: str, data: bytes | int, source: str | None = None) -> None:
+        try:
+            self.received.put_nowait((kind, key, data, source))
+        except queue.Full:
+            self.dropped += 1
+
+    def _on_sample(self, sample: Any) -> None:
+        """O(1): size check before any copy, then hand over to the printing loop."""
+        key = str(sample.key_expr)
+        kind = key.rsplit("/", 1)[-1]
+        size = len(sample.payload)
+        info = sample.source_info
+        source = None if info is None else str(info.source_id)
+        self._emit(kind, key, size if size > self.max_bytes else sample.payload.to_bytes(), source)
+
+    def _on_vss(self, sample: Any) -> None:
+        """O(1) like `_on_sample`; the value is checked when printed (the bus is untrusted)."""
+        size = len(sample.payload)
+        data = size if size > VSS_MAX_BYTES else sample.payload.to_bytes()
+        self._emit("vss", str(sample.key_expr), data)
+
+    def _on_alive(self, sample: Any) -> None:
+        alive = sample.kind == self._sample_kind_put
+        self._emit("alive", str(sample.key_expr), json.dumps({"alive": alive}).encode())
+
+    def _on_miss(self, miss: Any) -> None:
+        self._emit("missed", self.keys.alert, int(miss.nb), str(miss.source))
+
+    def follow(self, timeout_s: float | None, stop: Any, endpoints: str) -> int:
+        from zenoh.ext import HistoryConfig, RecoveryConfig, declare_advanced_subscriber
+
+        session, keys = self.session, self.keys
+        alerts = declare_advanced_subscriber(
+            session,
+            keys.alert,
+            self._on_sample,
+            history=HistoryConfig(detect_late_publishers=True, max_samples=self.history),
+            recovery=RecoveryConfig(heartbeat=True),  # type: ignore[call-arg]  # stub: both required
+        )
+        self.entities.append(alerts)
+        self.entities.append(alerts.sample_miss_listener(self._on_miss))
+        self.entities.append(session.declare_subscriber(keys.state, self._on_sample))
+        if not self.args.no_yaw:
+            self.entities.append(session.declare_subscriber(keys.yaw, self._on_sample))
+        self.entities.append(
+            session.liveliness().declare_subscriber(keys.alive, self._on_alive, history=True)
+        )
+        if self.vss_prefix is not None:
+            from roadgaze.transport import vss_key
+
+            self.entities.append(
+                session.declare_subscriber(vss_key("Vehicle.**", self.vss_prefix), self._on_vss)
+            )
+        deadline = None if timeout_s is None else time.monotonic() + timeout_s
+        printed = 0
+        while not stop.is_set() and (self.args.count is None or printed < self.args.count):
+            wait_s = 0.2 if deadline is None else min(0.2, deadline - time.monotonic())
+            if wait_s <= 0:
+                break
+            try:
+                kind, key, data, source = self.received.get(timeout=wait_s)
+            except queue.Empty:
+                continue
+            printed += self._print(kind, key, data, source)
+        if self.dropped:
+            _say(f"{self.dropped} messages dropped (printing too slow)")
+        if printed == 0 and timeout_s is not None and not stop.is_set():
+            if not self.ever_connected:
+                _say(
+                    f"connected to nothing ({endpoints}) in {timeout_s:g} s: is `roadgaze run` "
+                    "or a router up?"
+                )
             else:
-                print(format_vss(key, raw), flush=True)
-            return
-        payload, text = _decode(raw)
-        vehicle = _vehicle_of(key, zconf.prefix)
-        if args.json:
+                _say(
+                    f"received nothing on {self.keys.prefix}/* in {timeout_s:g} s: is a daemon "
+                    "publishing for this vehicle?"
+                )
+            return 1
+        return 0
+
+    def _print(self, kind: str, key: str, data: bytes | int, source: str | None) -> int:
+        from roadgaze.transport import PayloadError, printable
+
+        if kind == "vss":
+            return self._print_vss(key, data)
+        vehicle = vehicle_of(key, self.prefix_template)
+        if kind == "missed":
+            _say(
+                f"MISSED {data!r} alerts of {vehicle}: lost before this listener could recover "
+                "them (older than the daemon's zenoh.alert_cache_size)"
+            )
+            return 0
+        if isinstance(data, int):
+            self.warn(f"{kind} on {printable(key, 80)}: {data} bytes, limit {self.max_bytes}")
+            return 0
+        if kind == "alive":
+            payload: dict[str, Any] = json.loads(data)
+        else:
+            try:
+                checked = self.checker.check(kind, key, data, source)
+            except PayloadError as exc:
+                self.warn(f"{kind} on {printable(key, 80)}: {printable(str(exc))}")
+                return 0
+            payload = checked.payload
+            if checked.missing_before:
+                _say(
+                    f"GAP: {checked.missing_before} alerts of {vehicle} missing before #"
+                    f"{payload['seq']}"
+                )
+        self._show(kind, key, vehicle, payload)
+        return 1
+
+    def _print_vss(self, key: str, data: bytes | int) -> int:
+        from roadgaze.transport import PayloadError, parse_vss_text, printable
+
+        try:
+            if isinstance(data, int):
+                raise PayloadError(f"{data} bytes, limit {VSS_MAX_BYTES}")
+            value = parse_vss_text(key, data, self.vss_prefix or "")
+        except PayloadError as exc:
+            self.warn(f"vss on {printable(key, 80)}: {printable(str(exc))}")
+            return 0
+        if self.args.json:
+            print(json.dumps({"type": "vss", "key": key, "value": value}), flush=True)
+        else:
+            print(format_vss(key, value), flush=True)
+        return 1
+
+    def _show(self, kind: str, key: str, vehicle: str, payload: dict[str, Any]) -> None:
+        if self.args.json:
             record = {"type": kind, "key": key, "vehicle_id": vehicle, "payload": payload}
-            if payload is None:
-                record["raw"] = text
             print(json.dumps(record), flush=True)
         else:
-            print(format_pretty(kind, vehicle, payload, text), flush=True)
+            print(format_pretty(kind, vehicle, payload, ""), flush=True)
 
-    with open_session(zconf) as session:
-        if args.query_state:
-            timeout_s = 5.0 if args.timeout is None else args.timeout
-            statuses: list[str] = []
-            query_deadline = time.monotonic() + timeout_s
-            while not statuses and time.monotonic() < query_deadline:
-                # Right after opening, the routes to the queryable may not be known yet: ask again.
-                wait_s = max(0.05, min(1.0, query_deadline - time.monotonic()))
-                for reply in session.get(keys.state, timeout=wait_s):
-                    if reply.ok is not None:
-                        raw = reply.ok.payload.to_bytes()
-                        print_line("state", str(reply.ok.key_expr), raw)
-                        payload, _ = _decode(raw)
-                        statuses.append(str((payload or {}).get("status")))
-            if not statuses:
-                print(f"roadgaze listen: no answer from {keys.state}", file=sys.stderr)
-                return 1
-            return 0 if all(status == "running" for status in statuses) else 3
+    def query_state(self, timeout_s: float) -> int:
+        """Ask every state queryable (no consolidation: a second answerer is seen) and print."""
+        import zenoh
 
-        def on_data(sample: Any) -> None:
-            key = str(sample.key_expr)
-            emit(_kind_of(key), key, sample.payload.to_bytes())
+        from roadgaze.transport import PayloadError, printable
 
-        def on_alive(sample: Any) -> None:
-            alive = sample.kind == zenoh.SampleKind.PUT
-            emit("alive", str(sample.key_expr), json.dumps({"alive": alive}).encode())
-
-        entities = [session.declare_subscriber(keys.alert, on_data)]
-        entities.append(session.declare_subscriber(keys.state, on_data))
-        if not args.no_yaw:
-            entities.append(session.declare_subscriber(keys.yaw, on_data))
-        entities.append(session.liveliness().declare_subscriber(keys.alive, on_alive, history=True))
-        if zconf.vss:
-            vss_keys = vss_key("Vehicle.**", zconf.vss_prefix)
-
-            def on_vss(sample: Any) -> None:
-                emit("vss", str(sample.key_expr), sample.payload.to_bytes())
-
-            entities.append(session.declare_subscriber(vss_keys, on_vss))
-        printed = 0
-        try:
-            while args.count is None or printed < args.count:
-                wait_s = 0.2 if deadline is None else min(0.2, deadline - time.monotonic())
-                if wait_s <= 0:
-                    break
-                try:
-                    kind, key, raw = received.get(timeout=wait_s)
-                except queue.Empty:
+        deadline = time.monotonic() + timeout_s
+        answers: dict[str, list[str]] = {}
+        rejected = 0
+        while not answers and time.monotonic() < deadline:
+            # Right after opening, the routes to the queryable may not be known yet: ask again.
+            wait_s = max(0.05, min(1.0, deadline - time.monotonic()))
+            replies = self.session.get(
+                self.keys.state,
+                timeout=wait_s,
+                target=zenoh.QueryTarget.ALL,
+                consolidation=zenoh.ConsolidationMode.NONE,
+            )
+            for reply in replies:
+                if reply.ok is None:
                     continue
-                print_line(kind, key, raw)
-                printed += 1
-        except KeyboardInterrupt:
-            pass
-        finally:
-            for entity in entities:
+                key = str(reply.ok.key_expr)
+                try:
+                    checked = self.checker.check("state", key, reply.ok.payload.to_bytes())
+                except PayloadError as exc:
+                    _say(f"state answer on {printable(key, 80)} rejected: {printable(str(exc))}")
+                    rejected += 1
+                    continue
+                answers.setdefault(checked.vehicle_id, []).append(str(checked.payload["status"]))
+                self._show("state", key, checked.vehicle_id, checked.payload)
+        if not answers:
+            _say(f"no answer from {self.keys.state}")
+            return 1
+        twice = {vehicle: n for vehicle, statuses in answers.items() if (n := len(statuses)) > 1}
+        if twice:
+            _say(
+                f"suspicious: several answers for one vehicle {twice}: another process answers "
+                "on its state key (see docs/security.md)"
+            )
+            return 3
+        if rejected:
+            _say(
+                f"suspicious: {rejected} answer(s) rejected beside the valid one: another process "
+                "answers on the state key (see docs/security.md)"
+            )
+            return 3
+        statuses = [status for found in answers.values() for status in found]
+        return 0 if all(status == "running" for status in statuses) else 3
+
+    def close(self) -> None:
+        for entity in reversed(self.entities):
+            try:
                 entity.undeclare()
-        if dropped:
-            print(f"roadgaze listen: {dropped} messages dropped", file=sys.stderr)
-    return 0
+            except Exception as exc:
+                log.debug("undeclare failed: %s", exc)

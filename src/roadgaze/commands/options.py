@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +40,16 @@ def config_from_args(args: argparse.Namespace) -> Config:
 def add_zenoh_options(parser: Any) -> None:
     """Command-line options shared by run, replay --publish and listen."""
     group = parser.add_argument_group("zenoh")
-    group.add_argument("--vehicle-id", metavar="ID", help="vehicle id in the key expressions")
+    group.add_argument(
+        "--vehicle-id", metavar="ID", help="vehicle id in the key expressions ([A-Za-z0-9_-]{1,64})"
+    )
+    group.add_argument(
+        "--zenoh-config",
+        type=Path,
+        metavar="FILE",
+        help="a Zenoh JSON5 configuration file (e.g. from `roadgaze security init`) as the base; "
+        "the --zenoh-* options still override it",
+    )
     group.add_argument(
         "--zenoh-connect",
         action="append",
@@ -50,7 +60,7 @@ def add_zenoh_options(parser: Any) -> None:
         "--zenoh-listen",
         action="append",
         metavar="ENDPOINT",
-        help="endpoint to listen on (repeatable; default tcp/127.0.0.1:0)",
+        help="endpoint to listen on (repeatable; peer mode)",
     )
     group.add_argument("--zenoh-mode", choices=["peer", "client"], help="zenoh session mode")
     group.add_argument(
@@ -62,10 +72,15 @@ def add_zenoh_options(parser: Any) -> None:
 
 
 def zenoh_config_from_args(config: ZenohConfig, args: Any) -> ZenohConfig:
-    """`config` with the --vehicle-id/--zenoh-* options applied (validated again)."""
+    """`config` with the --vehicle-id/--zenoh-* options applied (validated again).
+
+    `--vehicle-id` must be a real id here (a daemon publishes under it); `listen` handles `*`.
+    """
     update: dict[str, Any] = {}
-    if getattr(args, "vehicle_id", None) and args.vehicle_id != "*":
+    if getattr(args, "vehicle_id", None) is not None:
         update["vehicle_id"] = args.vehicle_id
+    if getattr(args, "zenoh_config", None) is not None:
+        update["config_file"] = args.zenoh_config
     if getattr(args, "zenoh_connect", None):
         update["connect"] = list(args.zenoh_connect)
     if getattr(args, "zenoh_listen", None):
@@ -80,10 +95,64 @@ def zenoh_config_from_args(config: ZenohConfig, args: Any) -> ZenohConfig:
     try:
         return ZenohConfig.model_validate(merged)
     except ValidationError as exc:
-        problems = "; ".join(f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors())
+        problems = "; ".join(
+            f"{'.'.join(map(str, e['loc']))}: {e['msg']}".replace("vehicle_id", "--vehicle-id")
+            for e in exc.errors()
+        )
         raise ConfigError(f"bad zenoh option: {problems}") from None
 
 
 def with_zenoh_args(config: Config, args: Any) -> Config:
     """`config` with its `[zenoh]` section updated by the --vehicle-id/--zenoh-* options."""
     return config.model_copy(update={"zenoh": zenoh_config_from_args(config.zenoh, args)})
+
+
+def check_seconds(option: str, value: float | None) -> None:
+    """Raise ConfigError unless `value` (when given) is a finite number of seconds > 0: argparse
+    takes 'nan' and 'inf' as floats, and a loop waiting for NaN seconds never ends."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise ConfigError(f"{option} must be a finite number of seconds > 0, found {value}")
+
+
+PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".webp", ".tif", ".tiff")
+"""File types matplotlib writes (a plot is saved at the end: a bad name must fail at the start)."""
+
+
+def _same_file(first: Path, second: Path) -> bool:
+    try:
+        return first.resolve() == second.resolve() or (
+            first.exists() and second.exists() and first.samefile(second)
+        )
+    except OSError:
+        return False
+
+
+def check_output_paths(
+    inputs: dict[str, str | Path],
+    outputs: dict[str, str | Path | None],
+    suffixes: dict[str, tuple[str, ...]] | None = None,
+) -> None:
+    """Refuse, before anything is written, an output path that is an input (it would destroy
+    it), two outputs on one path (they would mix formats) and an output whose file type its
+    writer cannot write. Keys are the option names used in the message; '-' is stdout."""
+    given = {name: Path(path) for name, path in outputs.items() if path not in (None, "-")}
+    for name, path in given.items():
+        allowed = (suffixes or {}).get(name)
+        if allowed and path.suffix.lower() not in allowed:
+            raise ConfigError(
+                f"{name} {path}: cannot write a {path.suffix or 'suffix-less'} file; "
+                f"use {', '.join(allowed)}"
+            )
+        for input_name, input_path in inputs.items():
+            if _same_file(path, Path(input_path)):
+                raise ConfigError(
+                    f"{name} {path} is the input ({input_name}): it would be overwritten; "
+                    "choose another output path"
+                )
+    names = list(given)
+    for index, name in enumerate(names):
+        for other in names[index + 1 :]:
+            if _same_file(given[name], given[other]):
+                raise ConfigError(
+                    f"{name} and {other} are the same file {given[name]}; give each its own path"
+                )

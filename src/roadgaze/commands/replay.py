@@ -14,7 +14,13 @@ from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from roadgaze.commands.options import add_zenoh_options, common_options, with_zenoh_args
+from roadgaze.commands.options import (
+    PLOT_SUFFIXES,
+    add_zenoh_options,
+    check_output_paths,
+    common_options,
+    with_zenoh_args,
+)
 from roadgaze.config import Config
 from roadgaze.types import Alert, Frame, FrameRecord
 
@@ -157,11 +163,17 @@ def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.capture import open_source
     from roadgaze.daemon import bus_outputs
     from roadgaze.errors import ConfigError
+    from roadgaze.outputs.video import FOURCC_BY_SUFFIX
     from roadgaze.pipeline import Pipeline, create_detector
     from roadgaze.signals import sigterm_as_interrupt
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
+    check_output_paths(
+        {"VIDEO": args.source},
+        {"--out": args.out, "--csv": args.csv, "--plot": args.plot, "--annotate": args.annotate},
+        {"--plot": PLOT_SUFFIXES, "--annotate": tuple(FOURCC_BY_SUFFIX)},
+    )
     config = with_zenoh_args(config, args)
     stats = ReplayStats()
     with ExitStack() as stack:

@@ -16,9 +16,9 @@ def register(subparsers: Any) -> None:
         help="run the monitoring daemon and publish yaw, alerts, liveliness and state on Zenoh",
         description="Read a camera (/dev/videoN or an index) or a video file (paced at its own "
         "rate), estimate head yaw per frame, run the inattention monitor and publish on Zenoh "
-        "under vehicle/<id>/dms/. SIGINT/SIGTERM finish the current frame, publish a final state, "
-        "undeclare and exit 0. A lost camera and an unreachable Zenoh peer are retried and "
-        "reported in the state (degraded), never fatal.",
+        "under vehicle/<id>/dms/. SIGINT/SIGTERM/SIGHUP finish the current frame, publish a "
+        "final state, undeclare and exit 0. A lost camera and an unreachable Zenoh peer are "
+        "retried and reported in the state (degraded), never fatal.",
     )
     parser.add_argument(
         "--source", required=True, metavar="FILE|/dev/videoN|N", help="video file or camera"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +24,8 @@ class GroundTruth:
 def load_ground_truth(dataset_dir: Path) -> tuple[list[GroundTruth], int]:
     """Rows of `<dataset_dir>/ground_truth.csv` and how many were skipped for |pitch| = 90.
 
-    Raises `DatasetError` for a missing folder or file, missing columns or non-numeric values.
+    Raises `DatasetError` for a missing folder or file, missing columns, and missing, non-numeric
+    or non-finite values.
     """
     csv_path = dataset_dir / "ground_truth.csv"
     if not dataset_dir.is_dir():
@@ -42,15 +44,17 @@ def load_ground_truth(dataset_dir: Path) -> tuple[list[GroundTruth], int]:
                 )
             for line, row in enumerate(reader, start=2):
                 try:
-                    yaw_deg = float(row["yaw_deg"])
+                    yaw_deg = float(row["yaw_deg"])  # None (a short row) raises TypeError
                     pitch_text = (row.get("pitch_deg") or "").strip()
                     pitch_deg = float(pitch_text) if pitch_text else None
-                except ValueError:
+                    if not math.isfinite(yaw_deg) or not math.isfinite(pitch_deg or 0.0):
+                        raise ValueError("not finite")
+                except (TypeError, ValueError):
                     raise DatasetError(
-                        f"{csv_path}:{line}: yaw_deg/pitch_deg must be numbers, found "
-                        f"{row.get('yaw_deg')!r}/{row.get('pitch_deg')!r}"
+                        f"{csv_path}:{line}: yaw_deg/pitch_deg must be numbers (finite), found "
+                        f"{str(row.get('yaw_deg'))[:40]!r}/{str(row.get('pitch_deg'))[:40]!r}"
                     ) from None
-                if not row["file"]:
+                if not row.get("file"):
                     raise DatasetError(f"{csv_path}:{line}: empty file name")
                 if pitch_deg is not None and abs(pitch_deg) == 90.0:
                     skipped += 1

@@ -12,6 +12,8 @@ from __future__ import annotations
 import csv
 import json
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from enum import StrEnum
 from pathlib import Path
 from typing import IO, Any
@@ -191,6 +193,17 @@ def open_for_writing(path: Path, what: str, newline: str | None = None) -> IO[st
         raise RoadgazeError(f"cannot write {what} {path}: {exc.strerror or exc}") from None
 
 
+@contextmanager
+def naming(path: Path | None) -> Iterator[None]:
+    """An OSError raised while writing `path` names it (a full disk says which output)."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None and path is not None:
+            exc.filename = str(path)
+        raise
+
+
 class JsonlWriter(ClosesOnExit):
     """One JSON object per record and line, flushed line by line (nothing lost on a crash).
 
@@ -209,18 +222,20 @@ class JsonlWriter(ClosesOnExit):
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         assert self._file is not None, "writer is closed"
-        self._file.write(json.dumps(record_fields(record), allow_nan=False) + "\n")
-        if not self._owned:
-            self._file.flush()
+        with naming(self.path):
+            self._file.write(json.dumps(record_fields(record), allow_nan=False) + "\n")
+            if not self._owned:
+                self._file.flush()
         self.records += 1
 
     def close(self) -> None:
         if self._file is not None:
-            if self._owned:
-                self._file.close()
-            else:
-                self._file.flush()
-            self._file = None
+            file, self._file = self._file, None
+            with naming(self.path):
+                if self._owned:
+                    file.close()
+                else:
+                    file.flush()
 
 
 class CsvWriter(ClosesOnExit):
@@ -235,13 +250,15 @@ class CsvWriter(ClosesOnExit):
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         assert self._file is not None, "writer is closed"
         fields = record_fields(record)
-        if self._writer is None:
-            self._writer = csv.DictWriter(self._file, fieldnames=list(fields))
-            self._writer.writeheader()
-        self._writer.writerow({k: "" if v is None else v for k, v in fields.items()})
+        with naming(self.path):
+            if self._writer is None:
+                self._writer = csv.DictWriter(self._file, fieldnames=list(fields))
+                self._writer.writeheader()
+            self._writer.writerow({k: "" if v is None else v for k, v in fields.items()})
         self.records += 1
 
     def close(self) -> None:
         if self._file is not None:
-            self._file.close()
-            self._file = None
+            file, self._file = self._file, None
+            with naming(self.path):
+                file.close()

@@ -3,6 +3,7 @@
 from roadgaze.transport.health import Health
 from roadgaze.transport.keys import Keys
 from roadgaze.transport.link import ZenohLink
+from roadgaze.transport.link_state import AlertCounts, LinkState
 from roadgaze.transport.messages import (
     ALERT_SCHEMA,
     MESSAGE_MODELS,
@@ -16,18 +17,31 @@ from roadgaze.transport.messages import (
     YawMessage,
     json_schemas,
 )
+from roadgaze.transport.payloads import (
+    MESSAGE_MAX_BYTES,
+    SPEED_MAX_BYTES,
+    PayloadError,
+    parse_json_object,
+    parse_json_value,
+    printable,
+)
 from roadgaze.transport.publisher import BusPublisher, MessageLink
 from roadgaze.transport.session import (
+    SessionPlan,
     build_zenoh_config,
+    endpoint_in_use,
+    insecure_endpoints,
     open_session,
-    session_config_dict,
+    plan_session,
     zenoh_error_text,
 )
-from roadgaze.transport.speed import SpeedInput, parse_speed_kmh
+from roadgaze.transport.speed import SPEED_MAX_KMH, SpeedInput, parse_speed_kmh
+from roadgaze.transport.throttle import ThrottledWarning
 from roadgaze.transport.vss import (
     VSS_PATHS,
     VssLink,
     VssPublisher,
+    parse_vss_text,
     vss_key,
     vss_text,
     vss_values,
@@ -35,29 +49,43 @@ from roadgaze.transport.vss import (
 
 __all__ = [
     "ALERT_SCHEMA",
+    "MESSAGE_MAX_BYTES",
     "MESSAGE_MODELS",
+    "SPEED_MAX_BYTES",
+    "SPEED_MAX_KMH",
     "STATE_SCHEMA",
     "VSS_PATHS",
     "YAW_SCHEMA",
+    "AlertCounts",
     "AlertMessage",
     "BusPublisher",
     "EyeFields",
     "Health",
     "Keys",
+    "LinkState",
     "MessageLink",
     "MonitorSnapshot",
+    "PayloadError",
+    "SessionPlan",
     "SpeedInput",
     "StateMessage",
+    "ThrottledWarning",
     "TransportStatus",
     "VssLink",
     "VssPublisher",
     "YawMessage",
     "ZenohLink",
     "build_zenoh_config",
+    "endpoint_in_use",
+    "insecure_endpoints",
     "json_schemas",
     "open_session",
+    "parse_json_object",
+    "parse_json_value",
     "parse_speed_kmh",
-    "session_config_dict",
+    "parse_vss_text",
+    "plan_session",
+    "printable",
     "vss_key",
     "vss_text",
     "vss_values",

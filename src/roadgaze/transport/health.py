@@ -1,14 +1,13 @@
 """The service's health: counters, status and problems, answered on the `state` key.
 
-`Health` is a pipeline sink. It counts frames, faces and alerts, logs each alert once, notices
-when the Zenoh link comes or goes, and builds the `StateMessage` the state queryable answers
-(thread-safe: it reads only immutable records and plain counters).
+`Health` is a pipeline sink. It counts frames, faces and alerts, logs each alert once and builds
+the `StateMessage` the state queryable answers (thread-safe: it reads only immutable records and
+plain counters). The link logs its own changes (`LinkState`, from Zenoh's transport events).
 """
 
 from __future__ import annotations
 
 import logging
-import math
 import time
 from collections import deque
 from collections.abc import Callable
@@ -31,7 +30,6 @@ from roadgaze.types import Alert, Frame, FrameRecord
 log = logging.getLogger("roadgaze.daemon")
 
 Status = Literal["starting", "running", "degraded", "stopping", "stopped"]
-LINK_CHECK_PERIOD_S = 1.0
 RECENT_ALERTS = 100
 """Alerts kept for inspection; older ones are only counted (memory stays flat)."""
 
@@ -62,8 +60,6 @@ class Health:
         self.recent_alerts: deque[Alert] = deque(maxlen=RECENT_ALERTS)
         self.last: FrameRecord | None = None
         self._initial_verdict = verdict_of(config.monitor, initial_state(config.monitor))
-        self._link_connected: bool | None = None
-        self._link_checked_at = -math.inf
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         self.last = record
@@ -86,24 +82,10 @@ class Health:
                 alert.window_off_road_s,
                 extra={"alert": message.model_dump(mode="json", by_alias=True)},
             )
-        self._watch_link()
 
-    def _watch_link(self) -> None:
-        """Log when the Zenoh link comes or goes (checked at most once a second)."""
-        now = time.monotonic()
-        if self.link is None or now - self._link_checked_at < LINK_CHECK_PERIOD_S:
-            return
-        self._link_checked_at = now
-        connected = self.link.status().connected
-        if connected != self._link_connected:
-            if connected:
-                again = " again" if self._link_connected is False else ""
-                log.info("zenoh connected: publishing to subscribers%s", again)
-            else:
-                log.warning("zenoh not connected: monitoring goes on, state is degraded")
-            self._link_connected = connected
-
-    def _speed(self) -> tuple[float | None, Literal["none", "waiting", "fresh", "stale"]]:
+    def _speed(
+        self,
+    ) -> tuple[float | None, Literal["none", "waiting", "fresh", "stale", "invalid"]]:
         speed = None if self.link is None else self.link.speed
         if speed is None:
             return None, "none"

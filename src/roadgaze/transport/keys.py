@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
-from roadgaze.config import ZenohConfig
-from roadgaze.errors import TransportError
+from roadgaze.config import VEHICLE_ID_PATTERN, ZenohConfig
+from roadgaze.errors import ConfigError
+
+ALL_VEHICLES = "*"
 
 
 @dataclass(frozen=True, slots=True)
 class Keys:
-    """The key expressions of one vehicle (or of all, with vehicle id `*`)."""
+    """The key expressions of one vehicle (or, for subscribers only, of all: vehicle id `*`)."""
 
     vehicle_id: str
     prefix: str
@@ -22,18 +25,30 @@ class Keys:
 
     @classmethod
     def from_config(cls, config: ZenohConfig, vehicle_id: str | None = None) -> Keys:
+        """The keys a daemon publishes on. Raises `ConfigError` unless the vehicle id matches
+        `[A-Za-z0-9_-]{1,64}` (a wildcard or an empty id would publish as other vehicles)."""
         vid = config.vehicle_id if vehicle_id is None else vehicle_id
-        try:
-            prefix = config.prefix.format(vehicle_id=vid).strip("/")
-            speed = config.speed_key.format(vehicle_id=vid).strip("/") or None
-        except (KeyError, IndexError, ValueError) as exc:
-            raise TransportError(
-                f"zenoh.prefix/speed_key may only use the placeholder {{vehicle_id}}: {exc}"
-            ) from None
-        if not prefix:
-            raise TransportError("zenoh.prefix is empty; use e.g. 'vehicle/{vehicle_id}/dms'")
+        if not re.fullmatch(VEHICLE_ID_PATTERN, vid):
+            shown = vid if len(vid) <= 40 else f"{vid[:40]}... ({len(vid)} characters)"
+            raise ConfigError(
+                f"vehicle id must be 1-64 letters, digits, '_' or '-', found {shown!r}"
+            )
+        return cls._build(config, vid)
+
+    @classmethod
+    def matching(cls, config: ZenohConfig, vehicle_id: str | None = None) -> Keys:
+        """The keys a subscriber listens on: one vehicle, or every vehicle with None or `*`."""
+        if vehicle_id is None or vehicle_id == ALL_VEHICLES:
+            return cls._build(config, ALL_VEHICLES)
+        return cls.from_config(config, vehicle_id)
+
+    @classmethod
+    def _build(cls, config: ZenohConfig, vehicle_id: str) -> Keys:
+        # The templates were checked when the configuration was loaded (config.check_key_template).
+        prefix = config.prefix.format(vehicle_id=vehicle_id).strip("/")
+        speed = config.speed_key.format(vehicle_id=vehicle_id).strip("/") or None
         return cls(
-            vehicle_id=vid,
+            vehicle_id=vehicle_id,
             prefix=prefix,
             yaw=f"{prefix}/yaw",
             alert=f"{prefix}/alert",
@@ -41,3 +56,9 @@ class Keys:
             state=f"{prefix}/state",
             speed=speed,
         )
+
+    @property
+    def advanced(self) -> str:
+        """The keys Zenoh's advanced publisher and subscriber use beside the data key (cache
+        queries, heartbeats, publisher tokens): `**` never matches these `@adv` chunks."""
+        return f"{self.prefix}/*/@adv/**"

@@ -2,63 +2,88 @@
 
 Under the prefix (default `vehicle/{vehicle_id}/dms`):
 
-- `yaw`: one `YawMessage` per frame, congestion control DROP (a slow subscriber loses yaw
-  samples, never delays the pipeline);
-- `alert`: one `AlertMessage` per monitor event, priority INTERACTIVE_HIGH, congestion control
-  BLOCK (an alert is never dropped by the local queue);
-- `alive`: a liveliness token, present while the daemon runs;
-- `state`: a queryable answering a `StateMessage` (status, counters, config summary);
-- with `vss_keys`, one text publisher per COVESA VSS signal (`roadgaze.transport.vss`).
+- `alert`: one `AlertMessage` per monitor event through Zenoh's advanced publisher: reliable,
+  congestion control BLOCK, priority REAL_TIME, express, a cache of the last
+  `zenoh.alert_cache_size` alerts, sample-miss detection (heartbeat every 0.5 s) and publisher
+  detection. An advanced subscriber with history and recovery (`roadgaze listen`,
+  docs/zenoh.md) gets every alert in order: those of a link outage from the cache once the link
+  is back, and the last ones when it joins late. Plain subscribers get what is published while
+  they are connected.
+- `yaw`: one `YawMessage` per frame, congestion control DROP, priority DATA (droppable).
+- `alive`: a liveliness token, present while the daemon runs.
+- `state`: a queryable answering a `StateMessage` from a bounded thread (`StateResponder`).
+- with `vss_keys`, one text publisher per COVESA VSS signal (`roadgaze.transport.vss`):
+  congestion control BLOCK, priority DATA; no cache (every value is sent again each second).
 
-When the session cannot be opened (client mode and no router, say) the link is degraded:
-monitoring goes on, messages are counted as not sent (alerts are kept in a small bounded queue
-and sent once connected) and the session is re-opened with backoff in a background thread. In
-peer mode Zenoh itself retries the `connect` endpoints; the link reports degraded while none of
-them is connected.
+The link state comes from Zenoh's transport events (`LinkState`): an alert published while no
+transport is open is counted as held, never as sent. The speed subscriber keeps only the newest
+sample inside Zenoh; the frame loop reads it (`SpeedInput.kmh`). A peer session opens without a
+router; a client session cannot, so it is re-opened with backoff in a background thread while
+alerts wait in a bounded queue (then enter the cache like any other).
 """
 
 from __future__ import annotations
 
 import logging
 import threading
-import time
 from collections import deque
 from collections.abc import Callable
 from typing import Any
 
 from roadgaze.config import ZenohConfig
 from roadgaze.transport.keys import Keys
+from roadgaze.transport.link_state import LinkState
 from roadgaze.transport.messages import AlertMessage, TransportStatus, YawMessage
-from roadgaze.transport.session import build_zenoh_config, zenoh_error_text
+from roadgaze.transport.responder import QUERY_RING, StateResponder
+from roadgaze.transport.session import (
+    SessionPlan,
+    build_zenoh_config,
+    insecure_endpoints,
+    plan_session,
+    zenoh_error_text,
+)
 from roadgaze.transport.speed import SpeedInput
 from roadgaze.transport.vss import VSS_ATTACHMENT
 
 log = logging.getLogger(__name__)
 
-PENDING_ALERTS_MAX = 256
-"""Alerts kept while no session is open; the oldest are dropped (and counted) beyond this."""
-PENDING_FLUSH_WAIT_S = 2.0
-"""After a session (re)opens, how long kept alerts wait for a matching subscriber."""
+HEARTBEAT_S = 0.5
+"""How often the alert publisher announces its last sequence number (lost-alert detection)."""
 
 
 class _Declared:
     """Everything declared on one open session; closed together."""
 
-    def __init__(
-        self,
-        session: Any,
-        keys: Keys,
-        state_reply: Callable[[], bytes] | None,
-        speed: SpeedInput | None,
-        vss_keys: tuple[str, ...] = (),
-    ) -> None:
+    def __init__(self, session: Any, link: ZenohLink) -> None:
         import zenoh
+        from zenoh.ext import CacheConfig, MissDetectionConfig, declare_advanced_publisher
 
         self.session = session
         self._entities: list[Any] = []
-        self.vss: dict[str, Any] = {}
+        self.responder: StateResponder | None = None
+        keys = link.keys
         try:
-            for key in vss_keys:
+            self._entities.append(
+                session.info.declare_transport_events_listener(
+                    link.link_state.on_event, history=True
+                )
+            )
+            self.alert = declare_advanced_publisher(
+                session,
+                keys.alert,
+                encoding=zenoh.Encoding.APPLICATION_JSON,
+                reliability=zenoh.Reliability.RELIABLE,
+                congestion_control=zenoh.CongestionControl.BLOCK,
+                priority=zenoh.Priority.REAL_TIME,
+                express=True,
+                cache=CacheConfig(max_samples=link.config.alert_cache_size),
+                # The stub lists both keywords as required; the runtime takes one (zenoh 1.10).
+                sample_miss_detection=MissDetectionConfig(heartbeat=HEARTBEAT_S),  # type: ignore[call-arg]
+                publisher_detection=True,
+            )
+            self._entities.append(self.alert)
+            self.vss: dict[str, Any] = {}
+            for key in link.vss_keys:
                 self.vss[key] = session.declare_publisher(
                     key,
                     encoding=zenoh.Encoding.TEXT_PLAIN,
@@ -73,23 +98,23 @@ class _Declared:
                 priority=zenoh.Priority.DATA,
             )
             self._entities.append(self.yaw)
-            self.alert = session.declare_publisher(
-                keys.alert,
-                encoding=zenoh.Encoding.APPLICATION_JSON,
-                congestion_control=zenoh.CongestionControl.BLOCK,
-                priority=zenoh.Priority.INTERACTIVE_HIGH,
-            )
-            self._entities.append(self.alert)
-            if speed is not None and keys.speed is not None:
-                self._entities.append(
-                    session.declare_subscriber(
-                        keys.speed, lambda sample: speed.on_payload(sample.payload.to_bytes())
-                    )
+            if link.speed is not None and keys.speed is not None:
+                speed_subscriber = session.declare_subscriber(
+                    keys.speed, zenoh.handlers.RingChannel(1)
                 )
-            if state_reply is not None:
-                self._entities.append(
-                    session.declare_queryable(keys.state, _state_callback(keys.state, state_reply))
+                self._entities.append(speed_subscriber)
+
+                def newest_payload() -> Any:
+                    sample = speed_subscriber.try_recv()
+                    return None if sample is None else sample.payload
+
+                link.speed.attach(newest_payload)
+            if link.state_reply is not None:
+                queryable = session.declare_queryable(
+                    keys.state, zenoh.handlers.RingChannel(QUERY_RING)
                 )
+                self._entities.append(queryable)
+                self.responder = StateResponder(queryable.handler, link.state_reply, link.reply)
             self._entities.append(session.liveliness().declare_token(keys.alive))
         except BaseException:
             self.close()
@@ -102,29 +127,19 @@ class _Declared:
             except Exception as exc:
                 log.debug("undeclare failed: %s", exc)
         self._entities.clear()
+        if self.responder is not None:
+            self.responder.close()
         try:
             self.session.close()
         except Exception as exc:
             log.debug("session close failed: %s", exc)
 
 
-def _state_callback(key: str, state_reply: Callable[[], bytes]) -> Callable[[Any], None]:
-    import zenoh
-
-    def on_query(query: Any) -> None:
-        try:
-            query.reply(key, state_reply(), encoding=zenoh.Encoding.APPLICATION_JSON)
-        except Exception:
-            log.exception("could not answer a state query")
-
-    return on_query
-
-
 class ZenohLink:
     """The daemon's session: publishers, speed input, liveliness token and state queryable.
 
-    Use as a context manager. Never raises on publish: failures are counted and logged, and an
-    unopenable session is retried in the background with exponential backoff.
+    Use as a context manager. Never raises on publish: failures are counted and logged.
+    `state_reply` builds the state bytes (called from the responder thread).
     """
 
     def __init__(
@@ -133,24 +148,27 @@ class ZenohLink:
         keys: Keys,
         state_reply: Callable[[], bytes] | None = None,
         speed: SpeedInput | None = None,
+        plan: SessionPlan | None = None,
         vss_keys: tuple[str, ...] = (),
     ) -> None:
         self.config = config
         self.keys = keys
         self.vss_keys = vss_keys
-        self._state_reply = state_reply
+        self.state_reply = state_reply
         self.speed = speed
-        self._zconf = build_zenoh_config(config)  # bad settings fail here, at once
+        self._zconf, self.plan = build_zenoh_config(plan or plan_session(config, "daemon"))
+        self.link_state = LinkState(config.alert_cache_size)
         self._lock = threading.Lock()
         self._declared: _Declared | None = None
-        self._pending: deque[bytes] = deque(maxlen=PENDING_ALERTS_MAX)
+        self._pending: deque[bytes] = deque(maxlen=config.alert_cache_size)
+        self._pending_dropped = 0
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self.session_reopens = 0
         self.yaw_sent = 0
+        self.yaw_not_sent = 0
         self.vss_sent = 0
-        self.alerts_sent = 0
-        self.not_sent = 0
+        self.vss_not_sent = 0
         self.last_error: str | None = None
 
     def __enter__(self) -> ZenohLink:
@@ -161,6 +179,15 @@ class ZenohLink:
         self.close()
 
     def start(self) -> None:
+        """Log the endpoints, warn about plain TCP off this machine, open (or keep trying)."""
+        log.info("zenoh: %s", self.plan.describe())
+        insecure = insecure_endpoints(self.plan.connect + self.plan.listen)
+        if insecure:
+            log.warning(
+                "zenoh endpoints %s leave this machine without TLS: anyone on the network can "
+                "read, forge or silence alerts (see docs/security.md, roadgaze security init)",
+                ", ".join(insecure),
+            )
         if not self._try_open():
             self._thread = threading.Thread(
                 target=self._reopen_loop, name="zenoh-reopen", daemon=True
@@ -172,20 +199,23 @@ class ZenohLink:
 
         try:
             session = zenoh.open(self._zconf)
-            declared = _Declared(session, self.keys, self._state_reply, self.speed, self.vss_keys)
         except Exception as exc:
             self.last_error = zenoh_error_text(exc)
-            log.warning("zenoh session not available (%s); monitoring goes on", self.last_error)
+            log.warning(
+                "zenoh session not open yet (%s): monitoring goes on, alerts are held (up to "
+                "%d) and retried",
+                self.last_error,
+                self.config.alert_cache_size,
+            )
+            return False
+        try:
+            declared = _Declared(session, self)
+        except Exception as exc:
+            self.last_error = zenoh_error_text(exc)
+            log.error("zenoh declarations failed: %s", self.last_error)
             return False
         self.last_error = None
-        log.info("zenoh session open (%s), prefix %s", self.config.mode, self.keys.prefix)
-        if self._pending:
-            # Give subscribers a moment to be matched, so kept alerts reach somebody.
-            deadline = time.monotonic() + PENDING_FLUSH_WAIT_S
-            while not declared.alert.matching_status.matching and time.monotonic() < deadline:
-                if self._stop.wait(0.05):
-                    break
-        while True:
+        while True:  # alerts held before the session opened go first, in order
             with self._lock:
                 if self._stop.is_set():
                     declared.close()
@@ -206,16 +236,22 @@ class ZenohLink:
                 return
             delay_s = min(delay_s * 2.0, self.config.reconnect_max_s)
 
+    def reply(self, query: Any, data: bytes) -> None:
+        """Answer one state query (called by the responder thread)."""
+        import zenoh
+
+        query.reply(self.keys.state, data, encoding=zenoh.Encoding.APPLICATION_JSON)
+
     def publish_yaw(self, message: YawMessage) -> None:
         declared = self._declared
-        if declared is None:
-            self.not_sent += 1
+        if declared is None or not self.link_state.up:
+            self.yaw_not_sent += 1  # droppable by design: nobody could receive it
             return
         try:
             declared.yaw.put(message.to_json_bytes())
             self.yaw_sent += 1
         except Exception as exc:
-            self.not_sent += 1
+            self.yaw_not_sent += 1
             self.last_error = f"yaw put failed: {exc}"
 
     def publish_vss(self, key: str, payload: bytes) -> None:
@@ -224,88 +260,94 @@ class ZenohLink:
         declared = self._declared
         publisher = None if declared is None else declared.vss.get(key)
         if publisher is None:
-            self.not_sent += 1
+            self.vss_not_sent += 1
             return
         try:
             publisher.put(payload, attachment=VSS_ATTACHMENT)
             self.vss_sent += 1
         except Exception as exc:
-            self.not_sent += 1
+            self.vss_not_sent += 1
             self.last_error = f"vss put failed: {exc}"
 
     def publish_alert(self, message: AlertMessage) -> None:
+        """Publish (or, before a client session opens, hold) one alert; never raises."""
         payload = message.to_json_bytes()
-        with self._lock:
-            if self._declared is None:
-                if len(self._pending) == self._pending.maxlen:
-                    self.not_sent += 1
-                self._pending.append(payload)
-                log.warning("alert %s kept until the zenoh session opens", message.kind)
-                return
-        self._put_alert(payload)
-
-    def _put_alert(self, payload: bytes) -> None:
-        # Never hold the lock while Zenoh may block: its callbacks (state queries) take it too.
         with self._lock:
             declared = self._declared
             if declared is None:
+                if len(self._pending) == self._pending.maxlen:
+                    self._pending_dropped += 1
+                    log.error("alert held before the session opened was dropped: queue full")
                 self._pending.append(payload)
+                log.warning("alert %s held until the zenoh session opens", message.kind.value)
                 return
         self._put(declared, payload)
 
     def _put(self, declared: _Declared, payload: bytes) -> None:
+        # Never under self._lock: a BLOCK put may wait for a slow subscriber.
         try:
             declared.alert.put(payload)
-            self.alerts_sent += 1
         except Exception as exc:
-            self.not_sent += 1
+            self.link_state.count_alert(published=False)
             self.last_error = f"alert put failed: {exc}"
-            log.error("alert not sent: %s", exc)
+            log.error("alert not published: %s", exc)
+            return
+        self.link_state.count_alert(published=True)
 
     def status(self) -> TransportStatus:
         with self._lock:
             declared = self._declared
             pending = len(self._pending)
-        peers = routers = 0
-        if declared is not None:
-            try:
-                info = declared.session.info
-                peers, routers = len(info.peers_zid()), len(info.routers_zid())
-            except Exception as exc:
-                log.debug("session info failed: %s", exc)
-        needs_link = bool(self.config.connect) or self.config.mode == "client"
-        connected = declared is not None and (not needs_link or peers + routers > 0)
-        speed_messages = self.speed.messages if self.speed is not None else 0
-        speed_rejected = self.speed.rejected if self.speed is not None else 0
+        routers, peers, clients = self.link_state.remotes()
+        counts = self.link_state.snapshot()
+        speed = self.speed
         return TransportStatus(
-            mode=self.config.mode,
+            mode="client"
+            if self.plan.mode == "client"
+            else "router"
+            if self.plan.mode == "router"
+            else "peer",
             session_open=declared is not None,
-            connected=connected,
+            connected=declared is not None and self.link_state.up,
             peers=peers,
             routers=routers,
             session_reopens=self.session_reopens,
             yaw_sent=self.yaw_sent,
             vss_sent=self.vss_sent,
-            alerts_sent=self.alerts_sent,
-            not_sent=self.not_sent,
+            alerts_sent=counts.sent,
+            not_sent=self.yaw_not_sent + self.vss_not_sent + counts.failed + self._pending_dropped,
             pending_alerts=pending,
-            speed_messages=speed_messages,
-            speed_rejected=speed_rejected,
+            speed_messages=speed.messages if speed is not None else 0,
+            speed_rejected=speed.rejected if speed is not None else 0,
+            clients=clients,
+            link_downs=self.link_state.downs,
+            connect=list(self.plan.connect),
+            listen=list(self.plan.listen),
+            alerts_published=counts.published,
+            alerts_held_while_down=counts.held_while_down + pending,
+            alerts_beyond_cache=counts.beyond_cache,
+            alerts_failed=counts.failed + self._pending_dropped,
+            alert_cache_size=self.config.alert_cache_size,
+            yaw_not_sent=self.yaw_not_sent,
+            speed_oversize=speed.oversize if speed is not None else 0,
+            state_queries_answered=(
+                declared.responder.answered
+                if declared is not None and declared.responder is not None
+                else 0
+            ),
         )
 
     def publish_final_state(self) -> None:
         """Put the current state on the state key (for subscribers; queries get it anyway)."""
-        if self._state_reply is None:
+        declared = self._declared
+        if self.state_reply is None or declared is None:
             return
         import zenoh
 
-        declared = self._declared
-        if declared is None:
-            return
         try:
             declared.session.put(
                 self.keys.state,
-                self._state_reply(),
+                self.state_reply(),
                 encoding=zenoh.Encoding.APPLICATION_JSON,
                 congestion_control=zenoh.CongestionControl.BLOCK,
             )
@@ -320,6 +362,6 @@ class ZenohLink:
         with self._lock:
             declared, self._declared = self._declared, None
             if self._pending:
-                log.warning("%d alerts never sent: no zenoh session", len(self._pending))
+                log.error("%d alerts never published: no zenoh session", len(self._pending))
         if declared is not None:
             declared.close()

@@ -33,6 +33,7 @@ class _Message(BaseModel):
         populate_by_name=True,
         extra="forbid",
         json_schema_serialization_defaults_required=True,  # every field is always published
+        allow_inf_nan=False,  # JSON has no NaN or Infinity; a message holding one is refused
     )
 
     def to_json_bytes(self) -> bytes:
@@ -208,20 +209,47 @@ class AlertMessage(_Message):
 
 
 class TransportStatus(_Message):
-    mode: Literal["peer", "client"]
+    """The Zenoh link as the daemon sees it (`roadgaze.state/3` adds every field after
+    `speed_rejected`)."""
+
+    mode: Literal["peer", "client", "router"]
     session_open: bool
     connected: bool
-    """Session open and, when `connect` endpoints are configured, at least one is connected."""
+    """A transport to a router, peer or client is open (Zenoh transport events)."""
     peers: int = 0
     routers: int = 0
     session_reopens: int = 0
     yaw_sent: int = 0
-    vss_sent: int = 0
-    alerts_sent: int = 0
-    not_sent: int = 0
-    pending_alerts: int = 0
+    vss_sent: int = Field(default=0, description="COVESA VSS values published.")
+    alerts_sent: int = Field(default=0, description="Alerts published while the link was up.")
+    not_sent: int = Field(
+        default=0, description="yaw_not_sent + VSS values not sent + alerts_failed."
+    )
+    pending_alerts: int = Field(
+        default=0, description="Client mode: alerts held by roadgaze until the session opens."
+    )
     speed_messages: int = 0
     speed_rejected: int = 0
+    clients: int = 0
+    link_downs: int = Field(default=0, description="Times the link went down since start.")
+    connect: list[str] = Field(default_factory=list, description="Endpoints connected to.")
+    listen: list[str] = Field(default_factory=list, description="Endpoints listened on.")
+    alerts_published: int = 0
+    alerts_held_while_down: int = Field(
+        default=0,
+        description="Published while no transport was open: in the publisher's cache, "
+        "delivered to subscribers with history or recovery once the link is back.",
+    )
+    alerts_beyond_cache: int = Field(
+        default=0,
+        description="Held while down and pushed out of the cache: lost to those "
+        "who had not received them.",
+    )
+    alerts_failed: int = 0
+    alert_cache_size: int = 0
+    yaw_not_sent: int = 0
+    speed_oversize: int = Field(default=0, description="Speed payloads dropped unread (size).")
+    state_queries_answered: int = 0
 
 
 class MonitorSnapshot(EyeFields):
@@ -239,7 +267,7 @@ class MonitorSnapshot(EyeFields):
     active_alerts: list[str]
     moving: bool
     speed_kmh: float | None
-    speed_source: Literal["none", "waiting", "fresh", "stale"]
+    speed_source: Literal["none", "waiting", "fresh", "stale", "invalid"]
     alert_counts: dict[str, int]
 
 
@@ -247,8 +275,10 @@ class StateMessage(_Message):
     """Answer of the `state` queryable: health, monitor state, counters and config summary.
 
     `roadgaze.state/2` added `zone`, `pitch_deg` and `neutral_pitch_deg` to `monitor`;
-    `roadgaze.state/3` adds the eye fields of the yaw message to `monitor`, and the status is
-    `degraded` (with a problem saying why) while the eyes have been unavailable too long.
+    `roadgaze.state/3` adds link and delivery fields to `transport` (see `TransportStatus`, and
+    `vss_sent`), the speed source `invalid`, the eye fields of the yaw message to `monitor`, and
+    the status `degraded` (with a problem saying why) while the eyes have been unavailable too
+    long. Every earlier field keeps its name and meaning.
     """
 
     schema_id: Literal["roadgaze.state/3"] = Field(default="roadgaze.state/3", alias="schema")

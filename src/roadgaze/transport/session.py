@@ -1,45 +1,143 @@
-"""Zenoh session configuration from roadgaze's settings, and a plain session for tools."""
+"""Zenoh session configuration: which endpoints a daemon or a consumer uses, and opening it.
+
+Without `connect` and `listen` (and without a Zenoh config file) everything meets at the
+rendezvous endpoint, `tcp/127.0.0.1:7447` by default: the daemon connects there when something
+already listens (a zenohd router, `roadgaze router` or another daemon) and otherwise listens
+there itself; consumers (`roadgaze listen`) connect there as clients. `SessionPlan` says what
+was chosen so the commands can log it.
+"""
 
 from __future__ import annotations
 
 import json
+import logging
+import socket
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from roadgaze.config import ZenohConfig
 from roadgaze.errors import TransportError
 
+log = logging.getLogger(__name__)
 
-def session_config_dict(config: ZenohConfig) -> dict[str, Any]:
-    """The Zenoh settings roadgaze applies (on top of `config_file` when one is given).
+Role = Literal["daemon", "consumer"]
+RENDEZVOUS_PROBE_S = 0.3
+LOOPBACK_HOSTS = ("127.", "[::1]", "localhost")
 
-    Without a file every field applies; with a file only the fields set explicitly in roadgaze's
-    configuration override it.
+
+@dataclass(frozen=True, slots=True)
+class SessionPlan:
+    """The session a command opens: mode, endpoints and why (for the start-up log line)."""
+
+    mode: str
+    connect: tuple[str, ...]
+    listen: tuple[str, ...]
+    settings: dict[str, Any]
+    """Zenoh config paths and values applied on top of the file (or of Zenoh's defaults)."""
+    config_file: Path | None = None
+    note: str = ""
+
+    def describe(self) -> str:
+        """One line: 'peer session, listening on tcp/127.0.0.1:7447 (...)'."""
+        parts = [f"{self.mode} session"]
+        if self.config_file is not None:
+            parts.append(f"from {self.config_file}")
+        if self.listen:
+            parts.append("listening on " + ", ".join(self.listen))
+        parts.append(
+            "connecting to " + ", ".join(self.connect) if self.connect else "connecting nowhere"
+        )
+        text = ", ".join(parts)
+        return f"{text} ({self.note})" if self.note else text
+
+
+def endpoint_in_use(endpoint: str, timeout_s: float = RENDEZVOUS_PROBE_S) -> bool:
+    """Whether something accepts TCP connections at a `tcp/HOST:PORT` or `tls/HOST:PORT`
+    endpoint; True for other protocols (they cannot be probed, so they are connected to)."""
+    protocol, _, address = endpoint.partition("/")
+    if protocol not in ("tcp", "tls"):
+        return True
+    host, _, port = address.rpartition(":")
+    host = host.strip("[]").split("#")[0]
+    try:
+        with socket.create_connection((host, int(port.split("#")[0])), timeout=timeout_s):
+            return True
+    except (OSError, ValueError):
+        return False
+
+
+def insecure_endpoints(endpoints: tuple[str, ...] | list[str]) -> list[str]:
+    """Endpoints that leave the machine without TLS (the daemon warns about them at start)."""
+    insecure = []
+    for endpoint in endpoints:
+        protocol, _, address = endpoint.partition("/")
+        if protocol not in ("tls", "quic") and not address.startswith(LOOPBACK_HOSTS):
+            insecure.append(endpoint)
+    return insecure
+
+
+def _retry(config: ZenohConfig) -> dict[str, Any]:
+    # Zenoh's default (1 s doubling to 4 s) can add 4 s before a restarted router is seen.
+    return {
+        "period_init_ms": round(config.reconnect_initial_s * 1000),
+        "period_max_ms": round(config.reconnect_max_s * 1000),
+        "period_increase_factor": 2,
+    }
+
+
+def plan_session(
+    config: ZenohConfig,
+    role: Role = "daemon",
+    probe: Callable[[str], bool] = endpoint_in_use,
+    mode: str | None = None,
+) -> SessionPlan:
+    """The session for `role`. A daemon uses `config.mode`; a consumer is a client unless `mode`
+    says peer (two peers linked only through a router do not hear each other).
+
+    With a Zenoh config file only the fields set explicitly in roadgaze's configuration override
+    the file; without one, every field applies and the rendezvous fills in missing endpoints.
     """
     explicit = config.model_fields_set if config.config_file is not None else None
 
     def wanted(name: str) -> bool:
         return explicit is None or name in explicit
 
+    chosen_mode = mode or (config.mode if role == "daemon" else "client")
+    connect, listen, note = list(config.connect), list(config.listen), ""
+    if explicit is None and not connect and not listen and config.rendezvous:
+        rendezvous = config.rendezvous
+        if role == "consumer" or chosen_mode == "client" or probe(rendezvous):
+            connect = [rendezvous]
+            if role == "daemon":
+                note = "the rendezvous; a router or another daemon listens there"
+        else:
+            listen = [rendezvous]
+            note = "the rendezvous; nothing listened there: consumers connect here"
     settings: dict[str, Any] = {}
-    if wanted("mode"):
-        settings["mode"] = config.mode
-    if wanted("connect") and config.connect:
-        settings["connect/endpoints"] = list(config.connect)
-        # Zenoh retries unreachable endpoints in the background; as often as roadgaze would.
-        settings["connect/retry"] = {
-            "period_init_ms": round(config.reconnect_initial_s * 1000),
-            "period_max_ms": round(config.reconnect_max_s * 1000),
-            "period_increase_factor": 2,
-        }
-    if wanted("listen") and config.mode == "peer":
-        settings["listen/endpoints"] = list(config.listen)
+    if wanted("mode") or mode is not None:
+        settings["mode"] = chosen_mode
+    if connect and (wanted("connect") or explicit is None):
+        settings["connect/endpoints"] = connect
+        settings["connect/retry"] = _retry(config)
+    if chosen_mode == "peer" and (wanted("listen") or explicit is None):
+        settings["listen/endpoints"] = listen
+    elif chosen_mode == "client":
+        listen = []
+        if explicit is None or wanted("listen"):
+            settings["listen/endpoints"] = []
     if wanted("multicast_scouting"):
         settings["scouting/multicast/enabled"] = config.multicast_scouting
-    if config.mode == "client" and config.connect and wanted("connect"):
-        # Zenoh's client refuses to open without a router; roadgaze retries itself instead.
-        settings["connect/timeout_ms"] = 2000
-    return settings
+    return SessionPlan(
+        mode=chosen_mode,
+        connect=tuple(connect),
+        listen=tuple(listen),
+        settings=settings,
+        config_file=config.config_file,
+        note=note,
+    )
 
 
 def zenoh_error_text(exc: BaseException) -> str:
@@ -47,40 +145,72 @@ def zenoh_error_text(exc: BaseException) -> str:
     return str(exc).split(" at /")[0].rstrip(". ") or type(exc).__name__
 
 
-def build_zenoh_config(config: ZenohConfig) -> Any:
-    """A `zenoh.Config` from roadgaze's settings; raises TransportError for a bad file or value."""
+def _endpoints_of(zconf: Any, path: str, mode: str) -> tuple[str, ...]:
+    try:
+        value = json.loads(zconf.get_json(path))
+    except Exception:  # absent or not readable back: nothing to report
+        return ()
+    if isinstance(value, dict):  # per-mode endpoints: {"router": [...], "peer": [...]}
+        value = value.get(mode, [])
+    return tuple(str(item) for item in value) if isinstance(value, list) else ()
+
+
+def build_zenoh_config(plan: SessionPlan) -> tuple[Any, SessionPlan]:
+    """A `zenoh.Config` for `plan`, and the plan with the endpoints read back from it (a config
+    file may set them). Raises TransportError for a bad file or value."""
     import zenoh
 
-    if config.mode == "client" and not config.connect and not config.multicast_scouting:
-        raise TransportError(
-            "zenoh client mode needs a router: set zenoh.connect (e.g. tcp/127.0.0.1:7447) "
-            "or enable zenoh.multicast_scouting"
-        )
     try:
-        if config.config_file is not None:
-            path = Path(config.config_file)
+        if plan.config_file is not None:
+            path = Path(plan.config_file)
             if not path.is_file():
                 raise TransportError(f"zenoh config file {path} not found")
             zconf = zenoh.Config.from_file(str(path))
         else:
             zconf = zenoh.Config()
-        for key, value in session_config_dict(config).items():
+        for key, value in plan.settings.items():
             zconf.insert_json5(key, json.dumps(value))
+        mode = str(json.loads(zconf.get_json("mode")) or "peer")
     except TransportError:
         raise
     except Exception as exc:  # zenoh raises its own ZError for bad endpoints or files
         raise TransportError(f"bad zenoh configuration: {zenoh_error_text(exc)}") from None
-    return zconf
+    connect = _endpoints_of(zconf, "connect/endpoints", mode)
+    listen = _endpoints_of(zconf, "listen/endpoints", mode) if mode != "client" else ()
+    if mode == "client" and not connect:
+        raise TransportError(
+            "a zenoh client needs a router or daemon to connect to: set zenoh.connect "
+            "(e.g. tcp/127.0.0.1:7447) or zenoh.rendezvous"
+        )
+    resolved = SessionPlan(mode, connect, listen, plan.settings, plan.config_file, plan.note)
+    return zconf, resolved
 
 
-def open_session(config: ZenohConfig) -> Any:
-    """A plain Zenoh session for tools and listeners; raises TransportError when it cannot open."""
+def open_session(
+    plan: SessionPlan,
+    wait_s: float = 0.0,
+    stopped: Callable[[], bool] = lambda: False,
+    retry_s: float = 0.25,
+) -> Any:
+    """Open a session for `plan`. A client cannot open before its router (or daemon) answers:
+    it is retried every `retry_s` for up to `wait_s` (forever with `math.inf`) unless
+    `stopped()`. Raises TransportError when it cannot open."""
     import zenoh
 
-    zconf = build_zenoh_config(config)
-    try:
-        return zenoh.open(zconf)
-    except Exception as exc:
-        raise TransportError(
-            f"cannot open a zenoh session ({config.mode}): {zenoh_error_text(exc)}"
-        ) from None
+    zconf, plan = build_zenoh_config(plan)
+    deadline = time.monotonic() + wait_s
+    announced = False
+    while True:
+        try:
+            return zenoh.open(zconf)
+        except Exception as exc:
+            reason = zenoh_error_text(exc)
+        if stopped() or time.monotonic() + retry_s > deadline:
+            raise TransportError(
+                f"cannot open a zenoh session ({plan.describe()}): {reason}; is `roadgaze run` "
+                "or a router up?"
+            ) from None
+        if not announced:
+            log.info("waiting for a router or daemon (%s)", plan.describe())
+            announced = True
+        time.sleep(retry_s)

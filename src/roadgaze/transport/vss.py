@@ -30,9 +30,11 @@ Values (definitions and how the levels are computed: docs/zenoh.md):
 from __future__ import annotations
 
 import math
+import re
 from typing import Protocol
 
 from roadgaze.config import MonitorConfig
+from roadgaze.transport.payloads import PayloadError, printable
 from roadgaze.types import EyeStatus, Frame, FrameRecord, Gaze
 
 __all__ = [
@@ -42,6 +44,7 @@ __all__ = [
     "VSS_REFRESH_S",
     "VssLink",
     "VssPublisher",
+    "parse_vss_text",
     "vss_key",
     "vss_text",
     "vss_values",
@@ -71,12 +74,65 @@ VSS_PATHS: tuple[str, ...] = (
 
 VssValue = bool | float
 
+_PERCENT = (0.0, 100.0)
+_ANGLE = (-180.0, 180.0)
+VSS_RANGES: dict[str, tuple[float, float] | None] = {
+    f"{DRIVER}.IsEyesOnRoad": None,
+    f"{DRIVER}.DistractionLevel": _PERCENT,
+    f"{DRIVER}.AttentiveProbability": _PERCENT,
+    f"{DRIVER}.FatigueLevel": _PERCENT,
+    f"{HEAD}.Yaw": _ANGLE,
+    f"{HEAD}.Pitch": _ANGLE,
+    f"{HEAD}.Roll": _ANGLE,
+    f"{GAZE}.Azimuth": _ANGLE,
+    f"{GAZE}.Elevation": (-90.0, 90.0),
+    f"{DMS}.IsWarning": None,
+    f"{DMS}.IsError": None,
+}
+"""The type of each signal roadgaze publishes: None for a boolean, else the allowed range."""
+VSS_MAX_CHARS = 64
+_DECIMAL = re.compile(r"-?[0-9]{1,6}(\.[0-9]{1,6})?")
+
 
 def vss_key(path: str, prefix: str = "") -> str:
     """The Zenoh key of a VSS path: dots become slashes, under `prefix` when one is given."""
     key = path.replace(".", "/")
     prefix = prefix.strip("/")
     return f"{prefix}/{key}" if prefix else key
+
+
+def parse_vss_text(key: str, raw: bytes, prefix: str = "") -> str:
+    """Check one VSS value received from the bus (untrusted) and return its text.
+
+    A signal roadgaze publishes must be `true`/`false` or a finite decimal number inside its
+    range (`VSS_RANGES`); any other key under `Vehicle/` (another provider's) must be printable
+    UTF-8 text of at most `VSS_MAX_CHARS` characters. Raises `PayloadError` saying why not.
+    """
+    if len(raw) > 4 * VSS_MAX_CHARS:
+        raise PayloadError(f"value of {len(raw)} bytes, limit {4 * VSS_MAX_CHARS}")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise PayloadError("value is not UTF-8") from None
+    prefix = prefix.strip("/")
+    path = (key[len(prefix) + 1 :] if prefix and key.startswith(prefix + "/") else key).replace(
+        "/", "."
+    )
+    if path not in VSS_RANGES:
+        if len(text) > VSS_MAX_CHARS or printable(text, VSS_MAX_CHARS) != text:
+            raise PayloadError(f"value {printable(text, 20)!r} is not short printable text")
+        return text
+    limits = VSS_RANGES[path]
+    if limits is None:
+        if text not in ("true", "false"):
+            raise PayloadError(f"{path} must be true or false, found {printable(text, 20)!r}")
+        return text
+    if not _DECIMAL.fullmatch(text):
+        raise PayloadError(f"{path} must be a decimal number, found {printable(text, 20)!r}")
+    number = float(text)
+    if not (math.isfinite(number) and limits[0] <= number <= limits[1]):
+        raise PayloadError(f"{path} = {text} is outside {limits[0]:g}..{limits[1]:g}")
+    return text
 
 
 def vss_text(value: VssValue) -> bytes:

@@ -175,7 +175,7 @@ def _default_zones() -> list[ZoneConfig]:
     ]
 
 
-class MonitorConfig(_Section, EyeMonitorSettings):
+class MonitorConfig(EyeMonitorSettings):
     """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)

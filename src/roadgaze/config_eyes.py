@@ -8,16 +8,16 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
+
+from roadgaze.config_section import Section
 
 
-class EyesConfig(BaseModel):
+class EyesConfig(Section):
     """Eye measurement: which eyes are trusted and where their direction comes from.
 
     Defaults and their sources: docs/eyes.md.
     """
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     method: Literal["blendshapes", "iris"] = "blendshapes"
     """Eye-in-head direction from MediaPipe's eyeLook* blendshapes, or from the iris landmarks
@@ -41,7 +41,7 @@ class EyesConfig(BaseModel):
     """The lids look open (so low contrast means a lens, not a closed lid) above this openness."""
 
 
-class EyeMonitorSettings(BaseModel):
+class EyeMonitorSettings(Section):
     """The monitor's eye thresholds: closure, PERCLOS, blinks, gaze (fields of `[monitor]`)."""
 
     eyes_close_below: float = Field(default=0.14, gt=0)

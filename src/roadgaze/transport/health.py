@@ -74,12 +74,13 @@ class Health:
             self.alerts_raised += 1
             self.recent_alerts.append(alert)
             log.info(
-                "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)",
+                "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)%s",
                 alert.kind.value,
                 alert.level.value,
                 alert.t_s,
                 alert.off_road_s,
                 alert.window_off_road_s,
+                f": {alert.reason}" if alert.reason else "",
                 extra={"alert": message.model_dump(mode="json", by_alias=True)},
             )
 

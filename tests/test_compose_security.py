@@ -14,11 +14,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 
 from repo_paths import REPO
 from roadgaze.cli import main
 
-yaml = pytest.importorskip("yaml", reason="PyYAML comes with the ray extra (CI installs it)")
 pytestmark = pytest.mark.usefixtures("restore_logging")
 
 COMPOSE = REPO / "docker" / "compose.yaml"

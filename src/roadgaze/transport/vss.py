@@ -82,7 +82,7 @@ VSS_RANGES: dict[str, tuple[float, float] | None] = {
     f"{DRIVER}.AttentiveProbability": _PERCENT,
     f"{DRIVER}.FatigueLevel": _PERCENT,
     f"{HEAD}.Yaw": _ANGLE,
-    f"{HEAD}.Pitch": _ANGLE,
+    f"{HEAD}.Pitch": (-90.0, 90.0),
     f"{HEAD}.Roll": _ANGLE,
     f"{GAZE}.Azimuth": _ANGLE,
     f"{GAZE}.Elevation": (-90.0, 90.0),
@@ -142,11 +142,14 @@ def vss_text(value: VssValue) -> bytes:
     return repr(float(value)).encode("ascii")
 
 
-def _relative(value: float | None, neutral: float) -> float | None:
-    """`value - neutral` in degrees, wrapped into -180..180 (a full-range yaw of -179 with a
-    neutral of +5 is +176, not -184), rounded to 0.1; None when unknown."""
+def _relative(value: float | None, neutral: float, pitch: bool = False) -> float | None:
+    """`value - neutral` in degrees, rounded to 0.1, within VSS's range: a yaw wrapped into
+    -180..180 (a full-range yaw of -179 with a neutral of +5 is +176, not -184), a pitch held
+    within -90..90; None when unknown."""
     if value is None or not math.isfinite(value):
         return None
+    if pitch:
+        return round(min(90.0, max(-90.0, value - neutral)), 1)
     return round((value - neutral + 180.0) % 360.0 - 180.0, 1)
 
 
@@ -186,10 +189,10 @@ def vss_values(record: FrameRecord, config: MonitorConfig) -> dict[str, VssValue
     }
     angles = {
         f"{HEAD}.Yaw": _relative(verdict.yaw_deg, verdict.neutral_yaw_deg),
-        f"{HEAD}.Pitch": _relative(verdict.pitch_deg, verdict.neutral_pitch_deg),
+        f"{HEAD}.Pitch": _relative(verdict.pitch_deg, verdict.neutral_pitch_deg, pitch=True),
         f"{HEAD}.Roll": _relative(sample.roll_deg, 0.0),
         f"{GAZE}.Azimuth": _relative(eyes.gaze_yaw_deg, verdict.neutral_yaw_deg),
-        f"{GAZE}.Elevation": _relative(eyes.gaze_pitch_deg, verdict.neutral_pitch_deg),
+        f"{GAZE}.Elevation": _relative(eyes.gaze_pitch_deg, verdict.neutral_pitch_deg, pitch=True),
     }
     values.update({path: value for path, value in angles.items() if value is not None})
     return values

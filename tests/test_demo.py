@@ -86,8 +86,6 @@ def test_cli_demo_prints_alerts_as_received(tmp_path: Path, subprocess_env: dict
             str(tmp_path / "d"),
             "--timeline",
             SHORT_DRIVE,
-            "--log-level",
-            "WARNING",
         ],
         capture_output=True,
         text=True,
@@ -99,6 +97,16 @@ def test_cli_demo_prints_alerts_as_received(tmp_path: Path, subprocess_env: dict
     received = [line for line in result.stdout.splitlines() if "subscriber received alert" in line]
     assert len(received) == 2 and "long_distraction warning" in received[0]
     assert "2 alerts raised, 2 received by the subscriber" in result.stdout
+    # Results on stdout, the rest on stderr; each alert told once (by the subscriber).
+    assert all(line.startswith("demo: ") for line in result.stdout.splitlines())
+    assert "long_distraction" not in result.stderr and "cleared" not in result.stderr
+    written = [
+        line.split(": wrote ")[1] for line in result.stderr.splitlines() if ": wrote " in line
+    ]
+    assert sorted(Path(path).name for path in written) == sorted(
+        ["drive.mp4", "truth.csv", "frames.jsonl", "alerts.jsonl", "yaw.png", "annotated.mp4"]
+    )
+    assert "demo: rendering" in result.stderr
 
 
 def test_cli_demo_rejects_a_bad_timeline(tmp_path: Path, subprocess_env: dict[str, str]) -> None:

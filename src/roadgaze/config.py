@@ -97,6 +97,10 @@ class LandmarksConfig(_Section):
     min_tracking_confidence: float = Field(default=0.5, ge=0, le=1)
     driver: Literal["largest", "left", "right"] = "largest"
     """Which face is the driver: the largest, or the one on the image's left or right side."""
+    multi_face_check_s: float = Field(default=1.0, ge=0)
+    """In a stream, how often the one-face landmarker is checked for further faces (seconds);
+    0 runs the `max_faces` landmarker on every frame (slower: its face detector then runs on every
+    frame). See docs/landmarks.md."""
     mirror_average: bool = False
     """Also run the mirrored image and average the two measurements: exactly mirror-symmetric
     yaw and slightly better accuracy (docs/landmarks.md) for twice the landmarker time."""

@@ -98,6 +98,18 @@ def subscriber_config(config: Config, port: int) -> Config:
     return config.model_copy(update={"zenoh": zenoh})
 
 
+def wait_for_liveliness(session: Any, key: str, timeout_s: float) -> bool:
+    """True once a liveliness token matching `key` answers in `session`; False after
+    `timeout_s`."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        replies = session.liveliness().get(key, timeout=0.5)
+        if any(reply.ok is not None for reply in replies):
+            return True
+        time.sleep(0.05)
+    return False
+
+
 class AlertSubscriber:
     """A Zenoh subscriber to the alert key in its own session; appends each alert to a file.
 
@@ -142,13 +154,7 @@ class AlertSubscriber:
 
     def wait_for_publisher(self, timeout_s: float) -> bool:
         """True once the publisher's liveliness token is visible (routes are then in place)."""
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            replies = self._session.liveliness().get(self.keys.alive, timeout=0.5)
-            if any(reply.ok is not None for reply in replies):
-                return True
-            time.sleep(0.05)
-        return False
+        return wait_for_liveliness(self._session, self.keys.alive, timeout_s)
 
     def wait_for_count(self, count: int, timeout_s: float) -> bool:
         """True once `count` alerts have arrived; False after `timeout_s`."""
@@ -232,9 +238,9 @@ def run_demo(
     plot_path = out_dir / PLOT_NAME
     plot = YawPlot(
         plot_path,
-        title="roadgaze demo: synthetic drive (green band: road ahead)",
+        title="roadgaze demo: synthetic drive",
         truth=truth,
-        road_half_width_deg=config.monitor.road_half_width_deg,
+        monitor=config.monitor,
     )
     progress(f"running the service over {VIDEO_NAME}, Zenoh on tcp/127.0.0.1:{port}")
     with ExitStack() as stack:
@@ -250,7 +256,9 @@ def run_demo(
         if not subscriber.wait_for_publisher(SUBSCRIBER_WAIT_S):
             log.warning("the subscriber did not see the publisher within %.0f s", SUBSCRIBER_WAIT_S)
         frames_writer = stack.enter_context(JsonlWriter(out_dir / FRAMES_NAME))
-        annotated = stack.enter_context(AnnotatedVideoWriter(out_dir / ANNOTATED_NAME, fps))
+        annotated = stack.enter_context(
+            AnnotatedVideoWriter(out_dir / ANNOTATED_NAME, fps, monitor=config.monitor)
+        )
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, [*bus.sinks, plot, frames_writer, annotated])
         raised = bus.health.alerts_raised

@@ -9,26 +9,32 @@ independent of each other and of their order.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections import deque
+from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass, replace
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from roadgaze.capture import FrameSource, SourceStatus
 from roadgaze.config import Config, EyesConfig
+from roadgaze.handoff import Handoff
 from roadgaze.landmarks.eyes import driver_eyes
 from roadgaze.monitor import Monitor
 from roadgaze.pose import PoseEstimator
-from roadgaze.types import Frame, FrameRecord, LandmarkDetector
+from roadgaze.types import Detection, Frame, FrameRecord, LandmarkDetector
 
 STAGES = ("decode", "landmarks", "geometry", "smoothing", "monitor", "sinks", "total")
 """Timed stages; `total` is one whole loop iteration, from asking for the frame to the last sink."""
 
+READ_AHEAD_FRAMES = 2
+"""Frames a file source is decoded (and prepared) ahead of the loop: enough to hide decoding, few
+enough to keep memory flat."""
 STOP_GRACE_S = 1.0
 """After a stop is asked for, how long the frame in hand may take before a live source is closed
 (which unblocks a loop waiting for a lost camera)."""
@@ -70,15 +76,8 @@ class StageTimes:
     total_ms: float
 
     def as_tuple(self) -> tuple[float, ...]:
-        return (
-            self.decode_ms,
-            self.landmarks_ms,
-            self.geometry_ms,
-            self.smoothing_ms,
-            self.monitor_ms,
-            self.sinks_ms,
-            self.total_ms,
-        )
+        """The times in `STAGES` order."""
+        return tuple(getattr(self, name) for name in self.__slots__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,6 +88,38 @@ class ProcessedFrame:
     record: FrameRecord
     times: StageTimes
     """Before the sinks ran, `sinks_ms` is 0 and `total_ms` ends after the monitor."""
+
+
+@dataclass(frozen=True, slots=True)
+class _Decoded:
+    """A frame from the source, with its image prepared for the detector when it could be."""
+
+    frame: Frame
+    prepared: Any = None
+    """What the detector's `prepare(image)` made of the image (None: not prepared)."""
+
+
+def _decoded(
+    source: FrameSource, prepare: Callable[[Any], Any] | None, spent: deque[Any]
+) -> Iterator[_Decoded]:
+    """The decode thread's part: each frame and its prepared image. Prepared images come back
+    through `spent` to be released here, off the loop's thread (a `mediapipe.Image`: 0.25 ms)."""
+    for frame in source:
+        while spent:
+            spent.popleft()
+        yield _Decoded(frame, None if prepare is None else prepare(frame.image))
+
+
+@dataclass(frozen=True, slots=True)
+class _Detected:
+    """A frame after the landmark stage, on its way to the rest of the loop."""
+
+    frame: Frame
+    detection: Detection
+    decode_ms: float
+    landmarks_ms: float
+    received_s: float
+    """When the loop received the frame from its source (its `clock`, after pacing)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -107,6 +138,10 @@ class StageTimings:
         self._times_ms: npt.NDArray[np.float64] = np.zeros((capacity, len(STAGES)))
         self._count = 0
         self._to_skip = skip_first
+
+    def skip_next(self, frames: int) -> None:
+        """Do not record the next `frames` frames (the start-up of another pass)."""
+        self._to_skip = frames
 
     def add(self, times: StageTimes) -> None:
         if self._to_skip > 0:
@@ -174,6 +209,7 @@ class Pipeline:
         self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
         self.speed = speed
         self._clock = clock
+        self._frame_received_s = math.nan
 
     @classmethod
     def from_config(
@@ -187,12 +223,33 @@ class Pipeline:
             eyes=config.eyes,
         )
 
+    @property
+    def frame_received_s(self) -> float:
+        """When the loop received the frame in hand from its source (the `clock`, seconds; after
+        pacing); sinks read it during `on_record`, e.g. to measure latency. NaN before a frame."""
+        return self._frame_received_s
+
     def process(self, frame: Frame, decode_ms: float = 0.0) -> ProcessedFrame:
         """One frame through every stage; frames must come in time order."""
+        return self._finish(self._detect(_Decoded(frame), decode_ms, self._clock()))
+
+    def _detect(self, decoded: _Decoded, decode_ms: float, received_s: float) -> _Detected:
+        """The landmark stage of one frame (with the image prepared beforehand when it was)."""
+        frame = decoded.frame
+        start = self._clock()
+        detect_prepared = getattr(self.detector, "detect_prepared", None)
+        if decoded.prepared is not None and detect_prepared is not None:
+            detection: Detection = detect_prepared(decoded.prepared, frame.t_s)
+        else:
+            detection = self.detector.detect(frame.image, frame.t_s)
+        landmarks_ms = (self._clock() - start) * 1e3
+        return _Detected(frame, detection, decode_ms, landmarks_ms, received_s)
+
+    def _finish(self, detected: _Detected) -> ProcessedFrame:
+        """Pose, smoothing and monitor for a frame whose landmarks are known."""
         clock = self._clock
+        frame, detection = detected.frame, detected.detection
         start = clock()
-        detection = self.detector.detect(frame.image, frame.t_s)
-        after_landmarks = clock()
         driver = detection.driver
         yaw_raw_deg = self.pose.raw_yaw_deg(driver)
         # The matrix pitch's down gain starts at the monitor's current neutral pitch.
@@ -200,20 +257,19 @@ class Pipeline:
         eyes = driver_eyes(driver, yaw_raw_deg, self.eyes)
         after_geometry = clock()
         sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg, pitch_raw_deg)
-        if eyes is not None:
-            sample = replace(sample, eyes=eyes)
+        sample = sample if eyes is None else replace(sample, eyes=eyes)
         after_smoothing = clock()
         alerts = self.monitor.update(sample, self.speed())
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)
         after_monitor = clock()
         times = StageTimes(
-            decode_ms=decode_ms,
-            landmarks_ms=(after_landmarks - start) * 1e3,
-            geometry_ms=(after_geometry - after_landmarks) * 1e3,
+            decode_ms=detected.decode_ms,
+            landmarks_ms=detected.landmarks_ms,
+            geometry_ms=(after_geometry - start) * 1e3,
             smoothing_ms=(after_smoothing - after_geometry) * 1e3,
             monitor_ms=(after_monitor - after_smoothing) * 1e3,
             sinks_ms=0.0,
-            total_ms=decode_ms + (after_monitor - start) * 1e3,
+            total_ms=detected.decode_ms + detected.landmarks_ms + (after_monitor - start) * 1e3,
         )
         return ProcessedFrame(frame=frame, record=record, times=times)
 
@@ -224,31 +280,51 @@ class Pipeline:
         realtime: bool = False,
         max_frames: int | None = None,
         stop: StopSignal | None = None,
-    ) -> Iterator[ProcessedFrame]:
+    ) -> Generator[ProcessedFrame, None, None]:
         """The loop as an iterator. `realtime` paces a file source at its own timeline; `stop`
-        ends the loop before the next frame."""
+        ends the loop before the next frame.
+
+        A file is decoded, and each image prepared for the detector (`prepare`), in a thread of its
+        own `READ_AHEAD_FRAMES` ahead while the detector works; a camera grabs in its own thread.
+        The rest runs on the caller's thread with no hand-over, so a frame's latency is its own.
+        """
         clock = self._clock
-        iterator = iter(source)
         pace = realtime and not source.info.live
         first_t_s: float | None = None
         wall_start = 0.0
         produced = 0
-        while max_frames is None or produced < max_frames:
-            if stop is not None and stop.is_set():
-                return
-            before = clock()
-            frame = next(iterator, None)
-            decode_ms = (clock() - before) * 1e3
-            if frame is None:
-                return
-            if pace:
-                if first_t_s is None:
-                    first_t_s, wall_start = frame.t_s, clock()
-                wait_s = wall_start + (frame.t_s - first_t_s) - clock()
-                if wait_s > 0:
-                    time.sleep(wait_s)
-            yield self.process(frame, decode_ms)
-            produced += 1
+        spent: deque[Any] = deque(maxlen=2 * READ_AHEAD_FRAMES + 2)
+        with contextlib.ExitStack() as stack:
+            items: Iterator[_Decoded]
+            if source.info.live:
+                items = (_Decoded(frame) for frame in source)
+            else:
+                prepare = getattr(self.detector, "prepare", None)
+                decoding = Handoff(
+                    _decoded(source, prepare, spent), "roadgaze-decode", READ_AHEAD_FRAMES
+                )
+                items = iter(stack.enter_context(decoding))
+            while max_frames is None or produced < max_frames:
+                if stop is not None and stop.is_set():
+                    return
+                before = clock()
+                item = next(items, None)
+                decode_ms = (clock() - before) * 1e3
+                if item is None:
+                    return
+                if pace:
+                    if first_t_s is None:
+                        first_t_s, wall_start = item.frame.t_s, clock()
+                    wait_s = wall_start + (item.frame.t_s - first_t_s) - clock()
+                    if wait_s > 0:
+                        time.sleep(wait_s)
+                self._frame_received_s = clock()
+                detected = self._detect(item, decode_ms, self._frame_received_s)
+                if item.prepared is not None:
+                    spent.append(item.prepared)
+                del item  # the decode thread releases the prepared image
+                yield self._finish(detected)
+                produced += 1
 
     def run(
         self,
@@ -275,27 +351,27 @@ class Pipeline:
             watcher.start()
         wall_start = clock()
         try:
-            for processed in self.frames(
-                source, realtime=realtime, max_frames=max_frames, stop=stop
-            ):
-                before_sinks = clock()
-                for sink in sinks:
-                    sink.on_record(processed.record, processed.frame)
-                sinks_ms = (clock() - before_sinks) * 1e3
-                times = processed.times
-                timings.add(
-                    StageTimes(
-                        decode_ms=times.decode_ms,
-                        landmarks_ms=times.landmarks_ms,
-                        geometry_ms=times.geometry_ms,
-                        smoothing_ms=times.smoothing_ms,
-                        monitor_ms=times.monitor_ms,
-                        sinks_ms=sinks_ms,
-                        total_ms=times.total_ms + sinks_ms,
+            frames_in = self.frames(source, realtime=realtime, max_frames=max_frames, stop=stop)
+            with contextlib.closing(frames_in) as loop:  # closed at once, even on an error
+                for processed in loop:
+                    before_sinks = clock()
+                    for sink in sinks:
+                        sink.on_record(processed.record, processed.frame)
+                    sinks_ms = (clock() - before_sinks) * 1e3
+                    times = processed.times
+                    timings.add(
+                        StageTimes(
+                            decode_ms=times.decode_ms,
+                            landmarks_ms=times.landmarks_ms,
+                            geometry_ms=times.geometry_ms,
+                            smoothing_ms=times.smoothing_ms,
+                            monitor_ms=times.monitor_ms,
+                            sinks_ms=sinks_ms,
+                            total_ms=times.total_ms + sinks_ms,
+                        )
                     )
-                )
-                frames += 1
-                with_face += processed.record.sample.face
+                    frames += 1
+                    with_face += processed.record.sample.face
         finally:
             done.set()
         return RunSummary(

@@ -54,17 +54,48 @@ def test_model_fetch_copies_explicit_file_without_network(
     assert f"explicit: {real_model}: ok" in out and f"cache: {cached}: ok" in out
 
 
-def test_model_path_without_model_is_one_line_error(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+@pytest.mark.parametrize(
+    ("settings", "says", "never_says"),
+    [
+        ([], ["will download it from https://", "roadgaze model fetch"], "downloads are disabled"),
+        (
+            ["--set", "model.allow_download=false"],
+            ["downloads are disabled", "place the file by hand"],
+            "will download",
+        ),
+    ],
+    ids=["downloads-allowed", "downloads-disabled"],
+)
+def test_model_path_without_model_says_what_will_happen(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    settings: list[str],
+    says: list[str],
+    never_says: str,
 ) -> None:
     monkeypatch.delenv("ROADGAZE_MODEL_PATH", raising=False)
     monkeypatch.setenv("ROADGAZE_CACHE_DIR", str(tmp_path / "empty"))
-    assert main(["model", "path"]) == 2
+    assert main(["model", "path", *settings]) == 2
     captured = capsys.readouterr()
+    assert captured.out == ""
     error_lines = [line for line in captured.err.splitlines() if line.startswith("roadgaze")]
     assert len(error_lines) == 1
-    assert "downloads are disabled" in error_lines[0] and "place the file by hand" in error_lines[0]
+    for text in says:
+        assert text in error_lines[0]
+    assert never_says not in error_lines[0]
+    assert str(tmp_path / "empty" / MODEL_FILENAME) in error_lines[0]
+    assert not (tmp_path / "empty").exists()  # nothing was downloaded
     assert main(["model", "verify"]) == 1
+
+
+@pytest.mark.parametrize("action", ["fetch", "path", "verify"])
+def test_model_actions_describe_themselves(action: str, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["model", action, "--help"])
+    _usage, _, rest = capsys.readouterr().out.partition("\n\n")
+    description = rest.split("\n\n")[0]
+    assert len(description.split()) >= 15, description  # a paragraph, not just the usage
 
 
 def test_estimate_prints_one_json_object_per_image(

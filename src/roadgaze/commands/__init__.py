@@ -6,6 +6,7 @@ from roadgaze.commands import (
     batch,
     bench,
     demo,
+    doctor,
     estimate,
     evaluate,
     listen,
@@ -32,6 +33,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     schema,
     security,
     paper,
+    doctor,
 )
 """Each module has `register(subparsers)`, which adds its parser and sets `handler(args, config)`.
 Heavy imports (MediaPipe, Zenoh, OpenCV) happen inside the handlers, so `--help` is fast."""

@@ -8,16 +8,19 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
+import logging
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from roadgaze.commands.options import common_options
 from roadgaze.config import Config
 from roadgaze.errors import ConfigError
+from roadgaze.logs import log_written
 
 if TYPE_CHECKING:
     from roadgaze.fleet import BatchOutcome
+
+log = logging.getLogger(__name__)
 
 EXIT_SOME_FAILED = 3
 EXIT_INTERRUPTED = 130
@@ -110,27 +113,32 @@ def run(args: argparse.Namespace, config: Config) -> int:
 
 
 def report(outcome: BatchOutcome, out_dir: Path) -> None:
-    """The closing lines on stderr: counts, pace, failed drives, where the outputs are."""
+    """The closing lines on stderr, through the log: counts, pace, failed drives, the outputs."""
     figures = outcome.to_json()
-    print(
-        f"batch: {figures['ok']} of {figures['drives']} drives ok ({figures['processed']} "
-        f"processed, {figures['resumed']} kept from an earlier run), {figures['failed']} failed; "
-        f"{figures['frames']} frames in {outcome.wall_s:.1f} s = {outcome.frames_per_s:.1f} "
-        f"frames/s on {outcome.engine} with {outcome.workers} "
-        f"worker{'' if outcome.workers == 1 else 's'}",
-        file=sys.stderr,
+    log.info(
+        "batch: %s of %s drives ok (%s processed, %s kept from an earlier run), %s failed; "
+        "%s frames in %.1f s = %.1f frames/s on %s with %s worker%s",
+        figures["ok"],
+        figures["drives"],
+        figures["processed"],
+        figures["resumed"],
+        figures["failed"],
+        figures["frames"],
+        outcome.wall_s,
+        outcome.frames_per_s,
+        outcome.engine,
+        outcome.workers,
+        "" if outcome.workers == 1 else "s",
     )
     for result in outcome.failed[:FAILED_LISTED]:
-        print(f"batch: failed {result.drive_id} ({result.path}): {result.error}", file=sys.stderr)
+        log.warning("batch: failed %s (%s): %s", result.drive_id, result.path, result.error)
     if len(outcome.failed) > FAILED_LISTED:
         more = len(outcome.failed) - FAILED_LISTED
-        print(f"batch: ... and {more} more failed (see the report)", file=sys.stderr)
+        log.warning("batch: ... and %s more failed (see the report)", more)
     if outcome.interrupted:
         left = figures["interrupted"] + figures["pending"]
-        print(
-            f"batch: stopped; {left} drives not done; run the same command again to continue",
-            file=sys.stderr,
+        log.warning(
+            "batch: stopped; %s drives not done; run the same command again to continue", left
         )
-    print(
-        f"batch: wrote {out_dir / 'summary.parquet'} and {out_dir / 'report.html'}", file=sys.stderr
-    )
+    log_written(out_dir / "summary.parquet")
+    log_written(out_dir / "report.html")

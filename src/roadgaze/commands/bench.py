@@ -1,28 +1,47 @@
-"""`roadgaze bench VIDEO`: per-stage time, end-to-end fps, loop overhead and memory growth."""
+"""`roadgaze bench VIDEO`: per-stage time, throughput against raw MediaPipe, latency, memory."""
 
 from __future__ import annotations
 
 import argparse
 import json
-import time
+import logging
+import math
+import statistics
+from collections.abc import Callable, Sequence
+from contextlib import ExitStack, closing
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from roadgaze.commands.options import check_seconds, common_options
 from roadgaze.config import Config
-from roadgaze.types import Frame, FrameRecord
+
+if TYPE_CHECKING:
+    from roadgaze.benchmark import LatencyResult, RawResult
+    from roadgaze.capture import FrameSource
+    from roadgaze.pipeline import RunSummary, StageTimings
+
+log = logging.getLogger("roadgaze.bench")
+
+LATENCY_MARGIN_MS = 2.0
+"""The latency target: p99 capture-to-delivery at most the landmark stage's p99 plus this."""
 
 
 def register(subparsers: Any) -> None:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "bench",
         parents=[common_options()],
-        help="time each pipeline stage on a video: median and p99 ms, fps, overhead ratio",
+        help="time each pipeline stage on a video: ms per stage, fps, ratio to raw MediaPipe",
         description="Run the pipeline over a video as fast as possible, without outputs, and "
         "print per-stage median and p99 milliseconds (decode, landmarks, geometry, smoothing, "
-        "total), end-to-end fps and overhead_ratio = median total frame time / median landmark "
-        "time. --loop-seconds replays the video for that long; --memory adds resident-memory "
-        "growth over the run.",
+        "monitor, sinks, total), end-to-end fps and overhead_ratio = median total frame time / "
+        "median landmark time. In the same process MediaPipe's FaceLandmarker runs alone on the "
+        "same frames (VIDEO mode, one face, frames decoded beforehand, only detect_for_video "
+        "timed; before and after each pipeline pass): raw_mediapipe_fps and ratio_to_raw = the "
+        "pipeline's fps after the warm-up / the raw fps of the passes around it. --latency "
+        "publishes every frame on Zenoh over loopback and measures capture-to-delivery at a "
+        "subscriber. --loop-seconds replays the video for that long; --memory adds "
+        "resident-memory growth over the run. Results go to stdout, logs to stderr.",
     )
     parser.add_argument("source", metavar="VIDEO", help="video file (or image folder)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -42,117 +61,275 @@ def register(subparsers: Any) -> None:
         metavar="N",
         help="frames excluded from the timing statistics (model start-up), default 10",
     )
+    parser.add_argument(
+        "--latency",
+        action="store_true",
+        help="publish each frame's yaw message on Zenoh (loopback) and report capture-to-"
+        "delivery p50/p99 ms at a subscriber in the same process",
+    )
+    parser.add_argument(
+        "--repeat",
+        type=int,
+        default=1,
+        metavar="N",
+        help="N pipeline passes, each between two raw passes; ratio_to_raw is the median of the "
+        "N ratios (on a shared machine, repeat to see the spread)",
+    )
+    parser.add_argument(
+        "--no-raw", action="store_true", help="skip the raw MediaPipe passes (no ratio_to_raw)"
+    )
     parser.set_defaults(handler=run)
 
 
-def resident_mb() -> float:
-    """This process's resident memory (VmRSS) in MiB; NaN where /proc is not available."""
-    try:
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024.0
-    except OSError:
-        pass
-    return float("nan")
+def open_bench_source(args: argparse.Namespace, config: Config) -> FrameSource:
+    """The source of the timed pass: the file, or the file looped for --loop-seconds."""
+    from roadgaze.capture import LoopingSource, VideoFileSource, open_source
+    from roadgaze.errors import ConfigError
+
+    if args.loop_seconds is None:
+        return open_source(args.source, config)
+    path = Path(args.source)
+    if not path.is_file():
+        raise ConfigError(f"--loop-seconds needs a video file, found '{args.source}'")
+    return LoopingSource(lambda: VideoFileSource(path), duration_s=args.loop_seconds)
 
 
-class MemoryProbe:
-    """Samples VmRSS about once a second; the baseline is taken after `settle_s` of running."""
+def raw_pass(args: argparse.Namespace, config: Config, number: int, count: int) -> RawResult:
+    """One raw-MediaPipe pass over the source's frames (one pass of a looped file)."""
+    from roadgaze.benchmark import raw_mediapipe_pass
+    from roadgaze.capture import open_source
+    from roadgaze.landmarks.model_store import resolve_model
 
-    def __init__(self, settle_s: float = 10.0) -> None:
-        self._settle_s = settle_s
-        self._start = time.monotonic()
-        self._next = self._start
-        self.baseline_mb: float | None = None
-        self.last_mb = resident_mb()
-        self.peak_mb = self.last_mb
+    log.info("raw MediaPipe pass %d of %d", number, count)
+    with open_source(args.source, config) as source:
+        return raw_mediapipe_pass(
+            source, resolve_model(config.model), config.landmarks, args.warmup
+        )
 
-    def on_record(self, record: FrameRecord, frame: Frame) -> None:
-        now = time.monotonic()
-        if now < self._next:
-            return
-        self._next = now + 1.0
-        self.last_mb = resident_mb()
-        self.peak_mb = max(self.peak_mb, self.last_mb)
-        if self.baseline_mb is None and now - self._start >= self._settle_s:
-            self.baseline_mb = self.last_mb
 
-    def close(self) -> None:
-        self.last_mb = resident_mb()
+@dataclass(frozen=True, slots=True)
+class PassResult:
+    """One timed pass of the pipeline."""
 
-    @property
-    def growth_mb(self) -> float | None:
-        return None if self.baseline_mb is None else self.last_mb - self.baseline_mb
+    summary: RunSummary
+    fps: float | None
+    """After the warm-up (`ThroughputProbe`)."""
+    cpu_ms_per_frame: float | None
+    median_interval_ms: float | None
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
-    from contextlib import closing
-
-    from roadgaze.capture import FrameSource, LoopingSource, VideoFileSource, open_source
+    from roadgaze.benchmark import MemoryProbe, measure_latency, resident_mb
     from roadgaze.errors import ConfigError
-    from roadgaze.pipeline import STAGES, Pipeline, StageTimings, create_detector
+    from roadgaze.pipeline import StageTimings
 
     if args.warmup < 0:
         raise ConfigError(f"--warmup must be >= 0, found {args.warmup}")
     check_seconds("--loop-seconds", args.loop_seconds)
+    if args.repeat < 1:
+        raise ConfigError(f"--repeat must be at least 1, found {args.repeat}")
     rss_start_mb = resident_mb()
-    source: FrameSource
-    if args.loop_seconds is not None:
-        path = Path(args.source)
-        if not path.is_file():
-            raise ConfigError(f"--loop-seconds needs a video file, found '{args.source}'")
-        source = LoopingSource(lambda: VideoFileSource(path), duration_s=args.loop_seconds)
-    else:
-        source = open_source(args.source, config)
+    with open_bench_source(args, config) as first_source:
+        live = first_source.info.live
+    do_raw = not args.no_raw and not live
+    if live and not args.no_raw:
+        log.info("a live source cannot be replayed: no raw MediaPipe pass")
     settle_s = min(10.0, 0.1 * (args.loop_seconds or 0.0))
-    probe = MemoryProbe(settle_s=settle_s) if args.memory else None
-    timings = StageTimings(skip_first=args.warmup)
-    with source, closing(create_detector(config)) as detector:
-        pipeline = Pipeline.from_config(config, detector)
-        summary = pipeline.run(source, [probe] if probe else [], timings=timings)
+    memory = MemoryProbe(settle_s=settle_s) if args.memory else None
+    timings = StageTimings()
+    raw_passes: list[RawResult] = []
+    passes: list[PassResult] = []
+    latency = None
+    with ExitStack() as stack:
+        received_s: list[Callable[[], float]] = [lambda: math.nan]
+        rig = None
+        if args.latency:
+            rig = stack.enter_context(measure_latency(config, args.source, lambda: received_s[0]()))
+        if do_raw:
+            raw_passes.append(raw_pass(args, config, 1, args.repeat + 1))
+        for number in range(1, args.repeat + 1):
+            sinks: list[Any] = [*(rig.sinks if rig else ()), *([memory] if memory else [])]
+            timings.skip_next(args.warmup)
+            passes.append(pipeline_pass(args, config, sinks, timings, received_s))
+            if rig is not None:
+                published = sum(p.summary.frames for p in passes)
+                rig.probe.wait_for_count(published, 5.0)
+                latency = rig.probe.result(published)
+            if do_raw:
+                raw_passes.append(raw_pass(args, config, number + 1, args.repeat + 1))
     if timings.count == 0:
+        frames = passes[0].summary.frames
         raise ConfigError(
-            f"{args.source} has {summary.frames} frames, not more than --warmup {args.warmup}; "
+            f"{args.source} has {frames} frames, not more than --warmup {args.warmup}; "
             "lower --warmup"
         )
-    result: dict[str, Any] = {
-        "source": args.source,
-        "frames": summary.frames,
-        "frames_timed": timings.count,
-        "fps": round(summary.fps, 2),
-        "overhead_ratio": round(summary.overhead_ratio, 4),
-        "stages": {
-            stage: {"median_ms": round(stats.median_ms, 3), "p99_ms": round(stats.p99_ms, 3)}
-            for stage, stats in summary.stages.items()
-        },
-        "face_rate": round(summary.frames_with_face / summary.frames, 4) if summary.frames else 0,
-    }
-    if probe is not None:
-        growth = probe.growth_mb
+    result = bench_result(args.source, passes, timings, raw_passes, latency)
+    if memory is not None:
+        growth = memory.growth_mb
         result["memory"] = {
             "rss_start_mb": round(rss_start_mb, 1),
-            "rss_baseline_mb": None if probe.baseline_mb is None else round(probe.baseline_mb, 1),
-            "rss_end_mb": round(probe.last_mb, 1),
-            "rss_peak_mb": round(probe.peak_mb, 1),
+            "rss_baseline_mb": None if memory.baseline_mb is None else round(memory.baseline_mb, 1),
+            "rss_end_mb": round(memory.last_mb, 1),
+            "rss_peak_mb": round(memory.peak_mb, 1),
             "rss_growth_mb": None if growth is None else round(growth, 2),
-            "wall_s": round(summary.wall_s, 1),
+            "wall_s": round(sum(p.summary.wall_s for p in passes), 1),
         }
-    if args.json:
-        print(json.dumps(result))
-        return 0
-    print(f"bench {args.source}: {summary.frames} frames ({timings.count} timed) "
-          f"in {summary.wall_s:.1f} s")  # fmt: skip
-    print(f"{'stage':<10} {'median ms':>10} {'p99 ms':>10}")
-    for stage in STAGES:
-        stats = summary.stages[stage]
-        print(f"{stage:<10} {stats.median_ms:>10.3f} {stats.p99_ms:>10.3f}")
-    print(f"fps            {summary.fps:.1f}")
-    print(f"overhead_ratio {summary.overhead_ratio:.3f}")
-    if probe is not None:
+    print(json.dumps(result) if args.json else format_result(result))
+    return 0
+
+
+def pipeline_pass(
+    args: argparse.Namespace,
+    config: Config,
+    sinks: list[Any],
+    timings: StageTimings,
+    received_s: list[Callable[[], float]],
+) -> PassResult:
+    """One pass of the loop with a fresh detector (model start-up not timed)."""
+    from roadgaze.benchmark import ThroughputProbe
+    from roadgaze.pipeline import Pipeline, create_detector
+
+    throughput = ThroughputProbe(args.warmup)
+    with open_bench_source(args, config) as source, closing(create_detector(config)) as detector:
+        pipeline = Pipeline.from_config(config, detector)
+        received_s[0] = lambda: pipeline.frame_received_s
+        log.info("pipeline pass over %s", args.source)
+        summary = pipeline.run(source, [*sinks, throughput], timings=timings)
+    return PassResult(
+        summary, throughput.fps, throughput.cpu_ms_per_frame, throughput.median_interval_ms
+    )
+
+
+def _round(value: float | None, digits: int) -> float | None:
+    """`value` rounded; None (JSON null) for None, NaN or infinity."""
+    return None if value is None or not math.isfinite(value) else round(value, digits)
+
+
+def bench_result(
+    source: str,
+    passes: list[PassResult],
+    timings: StageTimings,
+    raw_passes: list[RawResult],
+    latency: LatencyResult | None,
+) -> dict[str, Any]:
+    """The JSON object `bench --json` prints (the keys of earlier versions kept)."""
+    stages = timings.stats()
+    frames = sum(p.summary.frames for p in passes)
+    wall_s = sum(p.summary.wall_s for p in passes)
+    with_face = sum(p.summary.frames_with_face for p in passes)
+    total, landmarks = stages.get("total"), stages.get("landmarks")
+    overhead = total.median_ms / landmarks.median_ms if total and landmarks else math.nan
+    pipeline_fps = _median([p.fps for p in passes])
+    cpu_ms = _median([p.cpu_ms_per_frame for p in passes])
+    interval_ms = _median([p.median_interval_ms for p in passes])
+    result: dict[str, Any] = {
+        "source": source,
+        "frames": frames,
+        "frames_timed": timings.count,
+        "fps": round(frames / wall_s, 2) if wall_s > 0 else 0.0,
+        "overhead_ratio": round(overhead, 4),
+        "stages": {
+            stage: {"median_ms": round(stats.median_ms, 3), "p99_ms": round(stats.p99_ms, 3)}
+            for stage, stats in stages.items()
+        },
+        "face_rate": round(with_face / frames, 4) if frames else 0,
+        "passes": len(passes),
+        "pipeline_fps": _round(pipeline_fps, 2),
+        "cpu_ms_per_frame": _round(cpu_ms, 3),
+        "raw_mediapipe_fps": None,
+        "ratio_to_raw": None,
+    }
+    raw = sum(raw_passes[1:], raw_passes[0]) if raw_passes else None
+    if raw is not None and raw.frames_timed:
+        # Each pipeline pass against the mean of the raw passes just before and after it.
+        ratios = [
+            p.fps / (0.5 * (before.fps + after.fps))
+            for p, before, after in zip(passes, raw_passes, raw_passes[1:], strict=False)
+            if p.fps is not None and before.fps > 0 and after.fps > 0
+        ]
+        result["raw_mediapipe_fps"] = round(raw.fps, 2)
+        result["ratio_to_raw"] = _round(_median(ratios), 4)
+        result["raw_mediapipe"] = {
+            "frames_timed": raw.frames_timed,
+            "median_ms": round(raw.percentile_ms(50), 3),
+            "p99_ms": round(raw.percentile_ms(99), 3),
+            "cpu_ms_per_frame": round(raw.cpu_ms_per_frame, 3),
+            "passes_fps": [round(fps, 2) for fps in raw.passes_fps],
+            "pipeline_passes_fps": [_round(p.fps, 2) for p in passes],
+            "ratios": [round(ratio, 4) for ratio in ratios],
+            "cpu_ratio_to_raw": None if not cpu_ms else round(raw.cpu_ms_per_frame / cpu_ms, 4),
+            "median_ratio_to_raw": None
+            if not interval_ms
+            else round(raw.percentile_ms(50) / interval_ms, 4),
+        }
+    if latency is not None:
+        target_ms = None if landmarks is None else landmarks.p99_ms + LATENCY_MARGIN_MS
+        result["latency"] = {
+            "published": latency.published,
+            "received": latency.received,
+            "p50_ms": _round(latency.p50_ms, 3),
+            "p99_ms": _round(latency.p99_ms, 3),
+            "max_ms": _round(latency.max_ms, 3),
+            "to_publish_p50_ms": _round(latency.to_publish_p50_ms, 3),
+            "to_publish_p99_ms": _round(latency.to_publish_p99_ms, 3),
+            "delivery_p50_ms": _round(latency.delivery_p50_ms, 3),
+            "delivery_p99_ms": _round(latency.delivery_p99_ms, 3),
+            "target_p99_ms": _round(target_ms, 3),
+            "meets_target": None if target_ms is None else bool(latency.p99_ms <= target_ms),
+        }
+    return result
+
+
+def _median(values: Sequence[float | None]) -> float | None:
+    known = [value for value in values if value is not None]
+    return float(statistics.median(known)) if known else None
+
+
+def format_result(result: dict[str, Any]) -> str:
+    """The human-readable table of a bench result."""
+    lines = [
+        f"bench {result['source']}: {result['frames']} frames ({result['frames_timed']} timed)",
+        f"{'stage':<10} {'median ms':>10} {'p99 ms':>10}",
+    ]
+    for stage, stats in result["stages"].items():
+        lines.append(f"{stage:<10} {stats['median_ms']:>10.3f} {stats['p99_ms']:>10.3f}")
+    lines.append(
+        f"fps            {result['fps']:.1f} (after the warm-up: {result['pipeline_fps']})"
+    )
+    lines.append(f"overhead_ratio {result['overhead_ratio']:.3f}")
+    if result["raw_mediapipe_fps"] is not None:
+        raw = result["raw_mediapipe"]
+        lines.append(
+            f"raw MediaPipe  {result['raw_mediapipe_fps']:.1f} fps (passes "
+            f"{', '.join(str(fps) for fps in raw['passes_fps'])}; median {raw['median_ms']} ms)"
+        )
+        lines.append(
+            f"ratio_to_raw   {result['ratio_to_raw']} (per pass: "
+            f"{', '.join(str(ratio) for ratio in raw['ratios'])})"
+        )
+        lines.append(
+            f"cpu ms/frame   {result['cpu_ms_per_frame']} (raw {raw['cpu_ms_per_frame']}; "
+            f"cpu_ratio_to_raw {raw['cpu_ratio_to_raw']})"
+        )
+        lines.append(f"median_ratio_to_raw {raw['median_ratio_to_raw']} (median frame times)")
+    if "latency" in result:
+        latency = result["latency"]
+        lines.append(
+            f"latency        p50 {latency['p50_ms']} ms, p99 {latency['p99_ms']} ms, max "
+            f"{latency['max_ms']} ms ({latency['received']} of {latency['published']} received; "
+            f"target p99 <= {latency['target_p99_ms']} ms: "
+            f"{'met' if latency['meets_target'] else 'not met'})"
+        )
+        lines.append(
+            f"  of which   to publish p50 {latency['to_publish_p50_ms']} / p99 "
+            f"{latency['to_publish_p99_ms']} ms, Zenoh delivery p50 {latency['delivery_p50_ms']} / "
+            f"p99 {latency['delivery_p99_ms']} ms"
+        )
+    if "memory" in result:
         memory = result["memory"]
-        print(
+        lines.append(
             f"memory: start {memory['rss_start_mb']} MiB, baseline {memory['rss_baseline_mb']} "
             f"MiB, end {memory['rss_end_mb']} MiB, peak {memory['rss_peak_mb']} MiB, "
-            f"growth {memory['rss_growth_mb']} MiB",
+            f"growth {memory['rss_growth_mb']} MiB"
         )
-    return 0
+    return "\n".join(lines)

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import sys
+import logging
 from pathlib import Path
 from typing import Any
 
 from roadgaze.commands.options import common_options
 from roadgaze.config import Config
+
+log = logging.getLogger("roadgaze.demo")
 
 
 def register(subparsers: Any) -> None:
@@ -21,7 +23,8 @@ def register(subparsers: Any) -> None:
         "yaw, pitch, smoother, monitor with zones, Zenoh publisher on 127.0.0.1) with a Zenoh "
         "subscriber in the same "
         "run, print each alert as the subscriber receives it, and write drive.mp4, truth.csv, "
-        "frames.jsonl, alerts.jsonl, yaw.png and annotated.mp4 into the output folder.",
+        "frames.jsonl, alerts.jsonl, yaw.png and annotated.mp4 into the output folder. The alerts "
+        "received and the summary go to stdout, progress and the log to stderr.",
     )
     parser.add_argument(
         "--out",
@@ -42,25 +45,30 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
+    """Alerts as the subscriber receives them and the closing summary go to stdout; progress,
+    the log and the files written to stderr. The service's own log line per alert is left out:
+    the subscriber's line tells the same event."""
     from roadgaze.demo import format_alert, run_demo
+    from roadgaze.logs import log_written, records_dropped
     from roadgaze.synth import parse_timeline
 
     timeline = None if args.timeline is None else parse_timeline(args.timeline)
 
     def progress(text: str) -> None:
-        print(f"demo: {text}", flush=True)
+        log.info("demo: %s", text)
 
     def alert(message: dict[str, Any]) -> None:
         print(f"demo: {format_alert(message)}", flush=True)
 
-    result = run_demo(
-        args.out,
-        config,
-        photo=args.photo,
-        timeline=timeline,
-        on_alert=alert,
-        on_progress=progress,
-    )
+    with records_dropped("roadgaze.daemon", lambda record: hasattr(record, "alert")):
+        result = run_demo(
+            args.out,
+            config,
+            photo=args.photo,
+            timeline=timeline,
+            on_alert=alert,
+            on_progress=progress,
+        )
     print(
         f"demo: {result.frames} frames, face in {result.frames_with_face}, "
         f"{result.alerts_raised} alerts raised, {len(result.alerts_received)} received by the "
@@ -71,8 +79,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
         f"total {result.total_s:.1f} s"
     )
     for path in result.files:
-        print(f"wrote {path}")
+        log_written(path)
     if len(result.alerts_received) != result.alerts_raised:
-        print("demo: the subscriber missed some alerts (see the log above)", file=sys.stderr)
+        log.error("demo: the subscriber missed some alerts (see the log above)")
         return 1
     return 0

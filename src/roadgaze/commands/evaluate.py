@@ -10,6 +10,7 @@ from typing import Any
 
 from roadgaze.commands.options import PLOT_SUFFIXES, check_output_paths, common_options
 from roadgaze.config import Config
+from roadgaze.logs import log_written
 
 
 def register(subparsers: Any) -> None:
@@ -22,7 +23,8 @@ def register(subparsers: Any) -> None:
         "MAE, RMSE, median error and detection rate per yaw model, for the service's yaw and for "
         "MediaPipe's own yaw, for |yaw| <= 60 deg, for all rows, and per 15 deg bin; with pitch "
         "labels also the pitch's rank correlation and mean error per tilt and the lap "
-        "classification (tilt -60 against |tilt| <= 15). Stills take neutral 0.",
+        "classification (tilt -60 against |tilt| <= 15). Stills take neutral 0. The report goes "
+        "to stdout, the progress bar and the log to stderr.",
     )
     parser.add_argument("dataset", type=Path, metavar="DATASET_DIR")
     parser.add_argument("--report", type=Path, metavar="JSON", help="write all figures as JSON")
@@ -112,13 +114,13 @@ def run(args: argparse.Namespace, config: Config) -> int:
     print(format_report(report))
     if args.predictions is not None:
         write_predictions(args.predictions, estimates)
-        print(f"wrote {args.predictions}")
+        log_written(args.predictions)
     if args.report is not None:
         write_report(args.report, report)
-        print(f"wrote {args.report}")
+        log_written(args.report)
     if args.plot is not None:
         save_plot(args.plot, truths, estimates)
-        print(f"wrote {args.plot}")
+        log_written(args.plot)
     if args.compare_landmarks is not None:
         table = format_landmark_comparison(
             compare_landmark_choices(truths, estimates, CANDIDATE_CHOICES, constants)
@@ -127,5 +129,5 @@ def run(args: argparse.Namespace, config: Config) -> int:
         args.compare_landmarks.write_text(table + "\n", encoding="utf-8")
         print()
         print(table)
-        print(f"wrote {args.compare_landmarks}")
+        log_written(args.compare_landmarks)
     return 0

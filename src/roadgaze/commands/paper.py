@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from roadgaze.config import Config
+from roadgaze.logs import log_written
 
 
 def register(subparsers: Any) -> None:
@@ -34,5 +35,5 @@ def run(args: argparse.Namespace, config: Config) -> int:
         print()
         if args.plots is not None:
             for path in save_plots(experiment, args.plots, stem):
-                print(f"wrote {path}")
+                log_written(path)
     return 0

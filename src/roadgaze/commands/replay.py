@@ -1,4 +1,4 @@
-"""`roadgaze replay VIDEO --out frames.jsonl`: run the pipeline over a recording, write per frame.
+"""`roadgaze replay VIDEO [--out frames.jsonl]`: the pipeline over a recording, a record per frame.
 
 `add_arguments` declares the options, `build_sinks` turns them into pipeline sinks, `run` opens
 source and detector, runs the loop and reports. Every sink reads the frame record, so a new
@@ -8,6 +8,7 @@ output is one option and one sink, in any order.
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import sys
 from contextlib import ExitStack
@@ -22,11 +23,14 @@ from roadgaze.commands.options import (
     with_zenoh_args,
 )
 from roadgaze.config import Config
-from roadgaze.types import Alert, Frame, FrameRecord
+from roadgaze.logs import log_written
+from roadgaze.types import Frame, FrameRecord
 
 if TYPE_CHECKING:
     from roadgaze.capture import SourceInfo
     from roadgaze.pipeline import RunSummary, Sink
+
+log = logging.getLogger("roadgaze.replay")
 
 
 def register(subparsers: Any) -> None:
@@ -35,10 +39,11 @@ def register(subparsers: Any) -> None:
         parents=[common_options()],
         help="run the pose pipeline over a video and write one record per frame",
         description="Run capture -> landmarks -> yaw, pitch, roll -> smoother -> monitor (zones) "
-        "over a video file (or image folder, or camera) and write one JSON object per frame. The "
-        "records are written line by line; at the normal end the files are rewritten once with "
-        "the offline (RTS) yaw_offline_deg and pitch_offline_deg filled (alerts stay computed "
-        "from the causal estimate). A progress bar with fps and ETA goes to stderr.",
+        "over a video file (or image folder, or camera) and write one JSON object per frame, to "
+        "stdout unless --out names a file. The records are written line by line; at the normal "
+        "end the files (not stdout) are rewritten once with the offline (RTS) yaw_offline_deg and "
+        "pitch_offline_deg filled (alerts stay computed from the causal estimate). A progress bar "
+        "with fps and ETA, the log (each alert once) and a closing summary go to stderr.",
     )
     add_arguments(parser)
     parser.set_defaults(handler=run)
@@ -49,7 +54,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "source", metavar="VIDEO", help="video file, image folder, /dev/videoN or camera index"
     )
     parser.add_argument(
-        "--out", metavar="FILE", help="JSON-lines output, one object per frame ('-' for stdout)"
+        "--out",
+        metavar="FILE",
+        help="JSON-lines file, one object per frame (default, or '-': stdout)",
     )
     parser.add_argument("--csv", type=Path, metavar="FILE", help="the same records as CSV")
     parser.add_argument(
@@ -67,7 +74,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="pace the replay at the source's own rate (default: as fast as possible)",
     )
     parser.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    parser.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress bar on stderr (none either when the records go to a terminal)",
+    )
     parser.add_argument(
         "--publish",
         action="store_true",
@@ -86,7 +97,7 @@ class ReplayStats:
         self.raw_max_deg = -math.inf
         self.smoothed_min_deg = math.inf
         self.smoothed_max_deg = -math.inf
-        self.alerts: list[Alert] = []
+        self.alerts = 0
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         sample = record.sample
@@ -98,7 +109,7 @@ class ReplayStats:
         if sample.yaw_deg is not None:
             self.smoothed_min_deg = min(self.smoothed_min_deg, sample.yaw_deg)
             self.smoothed_max_deg = max(self.smoothed_max_deg, sample.yaw_deg)
-        self.alerts.extend(record.alerts)
+        self.alerts += len(record.alerts)
 
     def close(self) -> None:
         return None
@@ -113,21 +124,25 @@ class ReplayStats:
         return text
 
 
-def build_sinks(args: argparse.Namespace, info: SourceInfo, stack: ExitStack) -> list[Sink]:
+def build_sinks(
+    args: argparse.Namespace, info: SourceInfo, stack: ExitStack, config: Config
+) -> list[Sink]:
     """The writer sinks the options ask for, each registered on `stack` to be closed at the end."""
     from roadgaze.outputs import AnnotatedVideoWriter, CsvWriter, JsonlWriter, ProgressBar, YawPlot
 
     sinks: list[Sink] = []
-    if args.out is not None:
-        target = sys.stdout if args.out == "-" else Path(args.out)
-        sinks.append(stack.enter_context(JsonlWriter(target)))
+    to_stdout = args.out in (None, "-")
+    sinks.append(stack.enter_context(JsonlWriter(sys.stdout if to_stdout else Path(args.out))))
     if args.csv is not None:
         sinks.append(stack.enter_context(CsvWriter(args.csv)))
     if args.plot is not None:
-        sinks.append(stack.enter_context(YawPlot(args.plot, title=Path(info.name).name)))
+        title = Path(info.name).name
+        sinks.append(stack.enter_context(YawPlot(args.plot, title, monitor=config.monitor)))
     if args.annotate is not None:
-        sinks.append(stack.enter_context(AnnotatedVideoWriter(args.annotate, info.fps or 30.0)))
-    if not args.no_progress:
+        writer = AnnotatedVideoWriter(args.annotate, info.fps or 30.0, monitor=config.monitor)
+        sinks.append(stack.enter_context(writer))
+    records_on_terminal = to_stdout and sys.stdout.isatty()
+    if not args.no_progress and not records_on_terminal:  # the records show the progress there
         total = info.frame_count
         if args.max_frames is not None and total is not None:
             total = min(total, args.max_frames)
@@ -136,27 +151,26 @@ def build_sinks(args: argparse.Namespace, info: SourceInfo, stack: ExitStack) ->
 
 
 def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) -> None:
-    print(
-        f"replay {args.source}: {stats.describe()}; {summary.fps:.1f} fps",
-        file=sys.stderr,
+    """The closing lines on stderr: the summary, the source's problems, the files written (each
+    alert was logged once, when it was raised)."""
+    alerts = stats.alerts
+    log.info(
+        "replay %s: %s; %d alert%s; %.1f fps",
+        args.source,
+        stats.describe(),
+        alerts,
+        "" if alerts == 1 else "s",
+        summary.fps,
     )
     status = summary.source_status
     if status.message:
-        print(f"replay {args.source}: {status.message}", file=sys.stderr)
+        log.warning("replay %s: %s", args.source, status.message)
     if status.frames_dropped:
-        print(f"replay {args.source}: {status.frames_dropped} frames dropped", file=sys.stderr)
+        log.warning("replay %s: %d frames dropped", args.source, status.frames_dropped)
     for name in ("out", "csv", "plot", "annotate"):
         value = getattr(args, name)
         if value is not None and value != "-":
-            print(f"wrote {value}", file=sys.stderr)
-    for alert in stats.alerts:
-        print(
-            f"replay {args.source}: alert {alert.kind.value} {alert.level.value} "
-            f"at t={alert.t_s:.2f}s (off road {alert.off_road_s:.2f}s, "
-            f"window {alert.window_off_road_s:.2f}s)"
-            + (f": {alert.reason}" if alert.reason else ""),
-            file=sys.stderr,
-        )
+            log_written(value)
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
@@ -182,11 +196,11 @@ def run(args: argparse.Namespace, config: Config) -> int:
         detector = create_detector(config)
         stack.callback(detector.close)
         bus = stack.enter_context(bus_outputs(config, args.source, args.publish))
-        sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack)]
+        sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack, config)]
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
-    report(args, summary, stats)
     fill_offline(args, config)
+    report(args, summary, stats)
     return 0
 
 
@@ -202,6 +216,6 @@ def fill_offline(args: argparse.Namespace, config: Config) -> None:
         try:
             fill_offline_columns(path, config.smoothing)
         except RoadgazeError as exc:
-            print(f"replay {args.source}: offline columns left null: {exc}", file=sys.stderr)
+            log.warning("replay %s: offline columns left null: %s", args.source, exc)
             continue
-        print(f"replay {args.source}: offline columns filled in {path}", file=sys.stderr)
+        log.debug("replay %s: offline columns filled in %s", args.source, path)

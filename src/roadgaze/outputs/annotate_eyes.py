@@ -8,6 +8,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.config import MonitorConfig
 from roadgaze.landmarks.eyes import EYES
 from roadgaze.types import EyeStatus, FrameRecord
 
@@ -59,8 +60,9 @@ def draw_eyes(canvas: npt.NDArray[np.uint8], record: FrameRecord, scale: float) 
     )
 
 
-def eyes_text(record: FrameRecord) -> str:
-    """One line: eyes open/closed/unavailable, openness, gaze and its source, closure, PERCLOS."""
+def eyes_line(record: FrameRecord, monitor: MonitorConfig | None = None) -> str:
+    """One line: eyes open/closed/unavailable, openness, gaze and its source, the closure (against
+    the microsleep threshold when the configuration is known), PERCLOS."""
     eyes = record.verdict.eyes
     text = f"eyes {eyes.status.value.upper()}"
     if eyes.openness is not None:
@@ -72,7 +74,8 @@ def eyes_text(record: FrameRecord) -> str:
             f"  gaze {eyes.gaze_yaw_deg:+.0f}/{eyes.gaze_pitch_deg:+.0f} deg ({eyes.gaze_source})"
         )
     if eyes.closure_s:
-        text += f"  closed {eyes.closure_s:.1f} s"
+        limit = "" if monitor is None else f"/{monitor.microsleep_s:g}"
+        text += f"  closed {eyes.closure_s:.1f}{limit} s"
     if eyes.perclos is not None:
         text += f"  PERCLOS {100 * eyes.perclos:.0f}%"
     if eyes.degraded:

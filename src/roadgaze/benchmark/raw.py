@@ -1,0 +1,126 @@
+"""MediaPipe's FaceLandmarker alone on a clip: the throughput roadgaze's loop is compared with.
+
+The reference is what a user would measure with MediaPipe and nothing else: VIDEO mode,
+`num_faces=1`, MediaPipe's default outputs (no transformation matrices, no blendshapes), the
+configured confidences, frames decoded and converted to RGB beforehand (in chunks of
+`CHUNK_FRAMES`, so memory stays bounded), and only `detect_for_video` timed, through MediaPipe's
+public Python API (its conversion of the result to Python objects included).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from itertools import islice
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from roadgaze.config import LandmarksConfig
+from roadgaze.types import Frame
+
+CHUNK_FRAMES = 64
+"""Frames decoded and converted before a run of timed calls (about 60 MB at 640x480)."""
+
+
+@dataclass(frozen=True, slots=True)
+class RawResult:
+    """The timed calls of one or more raw passes."""
+
+    durations_s: tuple[float, ...]
+    """Each timed `detect_for_video` call, seconds."""
+    cpu_s: float
+    """Process CPU time over the timed calls (all of MediaPipe's threads)."""
+    passes_fps: tuple[float, ...]
+
+    @property
+    def frames_timed(self) -> int:
+        return len(self.durations_s)
+
+    @property
+    def fps(self) -> float:
+        total = sum(self.durations_s)
+        return len(self.durations_s) / total if total > 0 else 0.0
+
+    @property
+    def cpu_ms_per_frame(self) -> float:
+        return 1e3 * self.cpu_s / len(self.durations_s) if self.durations_s else 0.0
+
+    def percentile_ms(self, percent: float) -> float:
+        if not self.durations_s:
+            return 0.0
+        return float(np.percentile(1e3 * np.asarray(self.durations_s), percent))
+
+    def __add__(self, other: RawResult) -> RawResult:
+        """Two passes together (e.g. one before and one after the loop's pass)."""
+        return RawResult(
+            self.durations_s + other.durations_s,
+            self.cpu_s + other.cpu_s,
+            self.passes_fps + other.passes_fps,
+        )
+
+
+def raw_mediapipe_pass(
+    frames: Iterable[Frame], model_path: Path, config: LandmarksConfig, warmup: int
+) -> RawResult:
+    """Time MediaPipe's `detect_for_video` over `frames` with a fresh landmarker (the first
+    `warmup` frames are not timed). Raises ModelError for a model MediaPipe cannot load."""
+    import cv2
+    import mediapipe as mp
+    from mediapipe.tasks.python import vision
+    from mediapipe.tasks.python.core.base_options import BaseOptions
+
+    from roadgaze.errors import ModelError
+    from roadgaze.landmarks.native_log import filtered_native_stderr
+
+    options = vision.FaceLandmarkerOptions(
+        base_options=BaseOptions(model_asset_path=str(model_path)),
+        running_mode=vision.RunningMode.VIDEO,
+        num_faces=1,
+        min_face_detection_confidence=config.min_detection_confidence,
+        min_face_presence_confidence=config.min_presence_confidence,
+        min_tracking_confidence=config.min_tracking_confidence,
+    )
+    try:
+        with filtered_native_stderr():
+            landmarker: Any = vision.FaceLandmarker.create_from_options(options)
+    except (RuntimeError, ValueError, OSError) as exc:
+        raise ModelError(f"cannot load face landmarker model {model_path}: {exc}") from None
+    durations_s: list[float] = []
+    cpu_s = 0.0
+    last_ms = -1
+    position = 0
+    try:
+        for chunk in _chunks(iter(frames), CHUNK_FRAMES):
+            images = [
+                (frame.t_s, np.ascontiguousarray(cv2.cvtColor(frame.image, cv2.COLOR_BGR2RGB)))
+                for frame in chunk
+            ]
+            for t_s, rgb in images:
+                image = mp.Image(image_format=mp.ImageFormat.SRGB, data=rgb)
+                timestamp_ms = max(round(t_s * 1000.0), last_ms + 1)
+                last_ms = timestamp_ms
+                cpu_before = time.process_time()
+                before = time.perf_counter()
+                if position < warmup:  # MediaPipe's first call logs its set-up on fd 2
+                    with filtered_native_stderr():
+                        landmarker.detect_for_video(image, timestamp_ms)
+                else:
+                    landmarker.detect_for_video(image, timestamp_ms)
+                elapsed_s = time.perf_counter() - before
+                if position >= warmup:
+                    durations_s.append(elapsed_s)
+                    cpu_s += time.process_time() - cpu_before
+                position += 1
+    finally:
+        with filtered_native_stderr():
+            landmarker.close()
+    fps = len(durations_s) / sum(durations_s) if durations_s else 0.0
+    return RawResult(tuple(durations_s), cpu_s, (fps,))
+
+
+def _chunks(frames: Iterator[Frame], size: int) -> Iterator[list[Frame]]:
+    while chunk := list(islice(frames, size)):
+        yield chunk

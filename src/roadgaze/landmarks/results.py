@@ -1,0 +1,162 @@
+"""FaceLandmarker results as numpy arrays, without one Python object per landmark.
+
+MediaPipe's Python API turns every landmark of every face into a `NormalizedLandmark` object
+(about 1.1 ms per face per frame on the development machine), which roadgaze then turned back into
+an array (another 0.9 ms). Where MediaPipe's Python package talks to its C library through ctypes
+(mediapipe >= 0.10.30), `run_landmarker` calls the same C function the public
+`detect`/`detect_for_video` calls and reads the landmark array straight out of the C result
+(0.05 ms); with any other MediaPipe it uses the public API and one vectorised conversion. Both give
+identical numbers (tested).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import importlib
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+Blendshapes = dict[str, float]
+"""MediaPipe's blendshape scores of one face by category name (`eyeBlinkLeft`: 0..1)."""
+FaceArrays = tuple[npt.NDArray[np.float32], npt.NDArray[np.float64] | None, Blendshapes | None]
+"""One face: (N, 3) landmarks x, y, z as MediaPipe normalises them (x, y in 0..1 of the image
+width and height, z in the scale of x), the 4x4 facial transformation matrix or None, and the
+blendshape scores or None (a landmarker made without `output_face_blendshapes`)."""
+
+
+class _CResultReader:
+    """The ctypes layout of MediaPipe's C result, checked once; None when it is not as expected."""
+
+    def __init__(self, result_type: Any, landmark_type: Any) -> None:
+        self.result_type = result_type
+        self.floats_per_landmark = ctypes.sizeof(landmark_type) // 4
+
+    @classmethod
+    def find(cls) -> _CResultReader | None:
+        try:
+            module = importlib.import_module("mediapipe.tasks.python.vision.face_landmarker")
+            landmark_c = importlib.import_module(
+                "mediapipe.tasks.python.components.containers.landmark_c"
+            )
+            result_type = module.MpFaceLandmarkerResultC
+            landmark_type = landmark_c.MpNormalizedLandmarkC
+        except (ImportError, AttributeError):
+            return None
+        layout_ok = (
+            (landmark_type.x.offset, landmark_type.y.offset, landmark_type.z.offset) == (0, 4, 8)
+            and ctypes.sizeof(landmark_type) % 4 == 0
+            and {
+                "face_landmarks",
+                "face_landmarks_count",
+                "facial_transformation_matrixes",
+                "face_blendshapes",
+                "face_blendshapes_count",
+            }
+            <= {name for name, *_ in result_type._fields_}
+        )
+        return cls(result_type, landmark_type) if layout_ok else None
+
+    def read(self, result: Any) -> list[FaceArrays]:
+        faces: list[FaceArrays] = []
+        matrices = [
+            result.facial_transformation_matrixes[i].to_numpy()
+            for i in range(result.facial_transformation_matrixes_count)
+        ]
+        blendshapes = [
+            _scores(result.face_blendshapes[i]) for i in range(result.face_blendshapes_count)
+        ]
+        for i in range(result.face_landmarks_count):
+            face = result.face_landmarks[i]
+            count = int(face.landmarks_count)
+            scores = blendshapes[i] if i < len(blendshapes) else None
+            if count == 0:
+                faces.append((np.empty((0, 3), np.float32), None, scores))
+                continue
+            pointer = ctypes.cast(face.landmarks, ctypes.POINTER(ctypes.c_float))
+            flat = np.ctypeslib.as_array(pointer, shape=(count * self.floats_per_landmark,))
+            points = flat.reshape(count, self.floats_per_landmark)[:, :3].copy()
+            matrix = np.asarray(matrices[i], np.float64) if i < len(matrices) else None
+            faces.append((points, matrix, scores))
+        return faces
+
+
+def _scores(categories: Any) -> Blendshapes:
+    """The scores of one face's C category list (52 entries: name and score each)."""
+    found: Blendshapes = {}
+    for j in range(int(categories.categories_count)):
+        category = categories.categories[j]
+        name = category.category_name
+        if name:
+            found[name.decode("utf-8", "replace")] = float(category.score)
+    return found
+
+
+@functools.cache
+def _reader() -> _CResultReader | None:
+    """Found on first use: importing MediaPipe waits until a landmarker runs."""
+    return _CResultReader.find()
+
+
+def uses_c_results(landmarker: Any) -> bool:
+    """True when `run_landmarker` reads this landmarker's results straight from the C library."""
+    lib = getattr(landmarker, "_lib", None)
+    return (
+        _reader() is not None
+        and getattr(landmarker, "_handle", None) is not None
+        and hasattr(lib, "MpFaceLandmarkerDetectForVideo")
+        and hasattr(lib, "MpFaceLandmarkerDetectImage")
+        and hasattr(lib, "MpFaceLandmarkerCloseResult")
+    )
+
+
+def run_landmarker(
+    landmarker: Any, image: Any, timestamp_ms: int | None, direct: bool = True
+) -> list[FaceArrays]:
+    """Every face MediaPipe's `landmarker` finds in the `mediapipe.Image` `image`.
+
+    `timestamp_ms` None: IMAGE mode (`detect`); an int: VIDEO mode (`detect_for_video`, strictly
+    increasing). `direct=False` forces the public API (tests compare the two). Errors are
+    MediaPipe's own (ValueError, RuntimeError).
+    """
+    reader = _reader() if direct else None
+    if reader is not None and uses_c_results(landmarker):
+        return _run_direct(landmarker, image, timestamp_ms, reader)
+    if timestamp_ms is None:
+        result = landmarker.detect(image)
+    else:
+        result = landmarker.detect_for_video(image, timestamp_ms)
+    matrices = result.facial_transformation_matrixes or []
+    blendshape_lists = result.face_blendshapes or []
+    faces: list[FaceArrays] = []
+    for index, face in enumerate(result.face_landmarks):
+        points = np.array([(p.x, p.y, p.z) for p in face], dtype=np.float32).reshape(-1, 3)
+        matrix = np.asarray(matrices[index], np.float64) if index < len(matrices) else None
+        scores = blendshape_lists[index] if index < len(blendshape_lists) else None
+        blendshapes = (
+            None if scores is None else {str(c.category_name): float(c.score) for c in scores}
+        )
+        faces.append((points, matrix, blendshapes))
+    return faces
+
+
+def _run_direct(
+    landmarker: Any, image: Any, timestamp_ms: int | None, reader: _CResultReader
+) -> list[FaceArrays]:
+    """What `detect`/`detect_for_video` do, minus the per-landmark Python objects."""
+    lib = landmarker._lib
+    result = reader.result_type()
+    if timestamp_ms is None:
+        lib.MpFaceLandmarkerDetectImage(
+            landmarker._handle, image._image_ptr, None, ctypes.byref(result)
+        )
+    else:
+        lib.MpFaceLandmarkerDetectForVideo(
+            landmarker._handle, image._image_ptr, None, timestamp_ms, ctypes.byref(result)
+        )
+    try:
+        return reader.read(result)
+    finally:
+        lib.MpFaceLandmarkerCloseResult(ctypes.byref(result))

@@ -6,9 +6,13 @@ history (for writer and publisher tests).
 
 from __future__ import annotations
 
+import os
+import socket
+import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import cv2
@@ -288,6 +292,48 @@ def alert_message(seq: int = 0, vehicle_id: str = "test-car") -> AlertMessage:
         off_road_s=3.0,
         window_off_road_s=3.0,
     )
+
+
+class FakeNotifySocket:
+    """Stands in for systemd's `$NOTIFY_SOCKET`: a datagram socket (a path, or an abstract name
+    when `abstract`) whose messages a thread keeps as `(received monotonic s, {KEY: value})`."""
+
+    def __init__(self, folder: Path, abstract: bool = False) -> None:
+        self._socket = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        if abstract:
+            name = f"roadgaze-test-{os.getpid()}-{id(self)}"
+            self._socket.bind("\0" + name)
+            self.address = "@" + name
+        else:
+            path = folder / "notify.sock"
+            self._socket.bind(str(path))
+            self.address = str(path)
+        self._socket.settimeout(0.1)
+        self.messages: list[tuple[float, dict[str, str]]] = []
+        self.raw: list[bytes] = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._receive, daemon=True)
+        self._thread.start()
+
+    def _receive(self) -> None:
+        while not self._stop.is_set():
+            try:
+                data = self._socket.recv(4096)
+            except TimeoutError:
+                continue
+            except OSError:
+                return
+            self.raw.append(data)
+            fields = dict(line.split("=", 1) for line in data.decode().splitlines())
+            self.messages.append((time.monotonic(), fields))
+
+    def with_key(self, key: str) -> list[tuple[float, dict[str, str]]]:
+        return [(t_s, fields) for t_s, fields in list(self.messages) if key in fields]
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=2.0)
+        self._socket.close()
 
 
 def die_on_crash_drives(task: Any) -> Any:

@@ -3,7 +3,8 @@
 The bundle is made with the exact command the compose file's header documents; then every Zenoh
 file a service is given (`--zenoh-config`, `ROADGAZE__ZENOH__CONFIG_FILE`, zenohd's `-c`) must be
 a generated file inside a folder that service mounts, and so must every certificate and key that
-file names. No Docker needed: the paths are checked as the containers would see them.
+file names; the router is `roadgaze router` on the router file (issue 15). No Docker needed: the
+paths are checked as the containers would see them.
 """
 
 from __future__ import annotations
@@ -93,15 +94,19 @@ def test_compose_services_use_the_generated_files(
             used[f"{name}:{container_path}"] = settings["mode"]
 
     assert used == {
-        "zenohd:/etc/roadgaze/zenoh/router/zenoh.json5": "router",
+        "router:/etc/roadgaze/zenoh/router/zenoh.json5": "router",
         "roadgaze:/etc/roadgaze/zenoh/daemon/zenoh.json5": "peer",
         "roadgaze:/etc/roadgaze/zenoh/consumer-health/zenoh.json5": "client",
         "listener:/etc/roadgaze/zenoh/consumer-listener/zenoh.json5": "client",
-        "replay:/etc/roadgaze/zenoh/daemon/zenoh.json5": "peer",
     }
+    assert services["router"]["command"][:2] == ["router", "--zenoh-config"]  # roadgaze router
+    assert services["router"]["ports"] == ["127.0.0.1:7447:7447"]  # the host: loopback only
+    for name, service in services.items():  # the Zenoh files set the sessions
+        overrides = {"ROADGAZE__ZENOH__CONNECT", "ROADGAZE__ZENOH__MODE"}
+        assert not overrides & set(service.get("environment", {})), name
     router = json.loads((generated / "router" / "zenoh.json5").read_text())
     daemon = json.loads((generated / "daemon" / "zenoh.json5").read_text())
     assert router["listen"]["endpoints"] == ["tls/0.0.0.0:7447"]
-    assert daemon["connect"]["endpoints"] == ["tls/zenohd:7447"]
+    assert daemon["connect"]["endpoints"] == ["tls/router:7447"]
     assert router["transport"]["link"]["tls"]["enable_mtls"] is True
     assert "access_control" in router and router["access_control"]["enabled"] is True

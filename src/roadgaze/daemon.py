@@ -81,21 +81,29 @@ def run_daemon(
 
     A camera that cannot be opened is waited for with backoff (capture.reconnect_*) and reported
     in the state as degraded; a missing file is a `SourceError`. An unreachable Zenoh peer never
-    stops monitoring (see `ZenohLink`).
+    stops monitoring (see `ZenohLink`). Under systemd (`$NOTIFY_SOCKET`) it sends READY, WATCHDOG
+    and STOPPING notifications (see `roadgaze.supervision`).
     """
     from roadgaze import capture
     from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.supervision import Supervisor
 
     stop = stop if stop is not None else StopFlag()
     with ExitStack() as stack:
         if handle_signals:
             stack.enter_context(signal_handlers(stop))
+        supervisor = stack.enter_context(
+            Supervisor.from_environment(stop, config.capture.reconnect_max_s)
+        )
         bus = stack.enter_context(bus_outputs(config, source_spec, publish=True))
         health = bus.health
         # The model loads before the camera opens, so no frame waits for MediaPipe.
+        supervisor.status("loading the face landmarker model")
         detector = stack.enter_context(closing(create_detector(config)))
+        supervisor.status(f"opening {source_spec}")
         source = stack.enter_context(capture.open_source(source_spec, config, wait_for_camera=True))
         health.source = source
+        supervisor.watch(source, source_spec)
         log.info(
             "roadgaze run: source %s, vehicle %s, prefix %s",
             source_spec,
@@ -103,8 +111,11 @@ def run_daemon(
             health.keys.prefix,
         )
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
-        pipeline.run(source, bus.sinks, realtime=realtime and not source.info.live, stop=stop)
+        pipeline.run(
+            source, (*bus.sinks, supervisor), realtime=realtime and not source.info.live, stop=stop
+        )
         health.status = "stopping"
+        supervisor.stopping(stop.signal_name or "end of source")
         log.info(
             "roadgaze run: stopping (%s) after %d frames, %d alerts",
             stop.signal_name or "end of source",

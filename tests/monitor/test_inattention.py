@@ -519,3 +519,27 @@ def test_a_road_pose_outside_the_road_zone_at_first_is_still_learned() -> None:
     lap_glance, _, _ = run_poses(lambda t: (0.0, -16.0 if t < 2.0 else -45.0), 6.0, config)
     assert lap_glance.state.neutral_pitch_deg == pytest.approx(-16.0)  # a lap glance does not teach
     assert lap_glance.verdict.zone == "lap"
+
+
+def test_a_turn_held_just_past_the_road_edge_early_in_a_drive_is_not_learned_as_ahead() -> None:
+    """3 s ahead, an eased half-second turn to about -27 deg held 5 s (how the one-face landmarker
+    reads `roadgaze synth --timeline '0:3,-30:5,0:3'`): the turn must raise long_distraction.
+
+    Before, samples within 25 deg of the neutral taught it: the transition moved the running
+    mean to about -2 deg, which brought the held turn within 25 deg, and the turn itself walked
+    the neutral to -8.5 deg here (-14.3 on the real clip, where the turn then read as road after
+    2.3 s and no alert fired). Now only samples within the road's entry bound (20 deg) teach.
+    """
+
+    def yaw_at(t: float) -> float:
+        if t < 3.0:
+            return -0.8
+        if t < 3.5:
+            u = (t - 3.0) / 0.5
+            return -0.8 - 27.0 * (3 * u * u - 2 * u**3)
+        return -27.8 + 0.15 * (t - 3.5) if t < 8.5 else -0.8  # as read: -27.8 drifting to -27.1
+
+    monitor, alerts = run(yaw_at, 11.0, MonitorConfig())
+    assert monitor.state.neutral_yaw_deg > -3.0, monitor.state.neutral_yaw_deg
+    kinds = [a.kind for a in alerts]
+    assert AlertKind.LONG_DISTRACTION in kinds

@@ -33,6 +33,18 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
-    from roadgaze.daemon import run_daemon
+    from roadgaze.signals import StopFlag, signal_handlers
 
-    return run_daemon(with_zenoh_args(config, args), args.source, realtime=not args.no_realtime)
+    stop = StopFlag()
+    # Handlers before the heavy imports: as PID 1 of a container, a SIGTERM arriving while
+    # they load would otherwise be ignored (PID 1 has no default action).
+    with signal_handlers(stop):
+        from roadgaze.daemon import run_daemon
+
+        return run_daemon(
+            with_zenoh_args(config, args),
+            args.source,
+            stop=stop,
+            realtime=not args.no_realtime,
+            handle_signals=False,
+        )

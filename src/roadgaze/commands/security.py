@@ -27,7 +27,8 @@ def register(subparsers: Any) -> None:
         "consumer. Only the daemon may publish under the vehicle's dms keys and the COVESA VSS "
         "keys (Vehicle/**, under zenoh.vss_prefix), only the speed provider may publish its "
         "speed, consumers may only subscribe and query. Use them with "
-        "`zenohd -c DIR/router/zenoh.json5`, `roadgaze run --zenoh-config "
+        "`roadgaze router --zenoh-config DIR/router/zenoh.json5` (or `zenohd -c` the same "
+        "file), `roadgaze run --zenoh-config "
         "DIR/daemon/zenoh.json5` and `roadgaze listen --zenoh-config "
         "DIR/consumer-NAME/zenoh.json5 --vehicle-id ID`.",
     )

@@ -26,10 +26,14 @@ def learn_neutral(
 ) -> tuple[float, float, float, float]:
     """The neutral yaw and pitch after this sample and the time each has learned from.
 
-    A sample teaches when the head looks roughly ahead: its yaw within `road_half_width_deg` of
-    the neutral yaw and its pitch within +-`neutral_pitch_limit_deg` (where a neutral pitch may
-    lie). This is wider than the road zone, so a camera above or below the line of sight, whose
-    road pose reads outside the road zone at first, is still learned. The gain is the larger of
+    A sample teaches when the head looks ahead: its yaw within the road's entry bound
+    (`road_half_width_deg - hysteresis_deg`) of the neutral yaw, and its pitch within
+    +-`neutral_pitch_limit_deg` (where a neutral pitch may lie). The pitch test is wider than the
+    road zone, so a camera above or below the line of sight, whose road pose reads outside the
+    road zone at first, is still learned. The yaw test is not: a sample in the hysteresis band
+    may be a glance held just past the road's edge, and learning from it would walk the neutral
+    after the glance until the glance reads as road (fail-safe: an alert is never learned
+    away). The gain is the larger of
     the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
     over the time learned so far): the neutral settles on the driver's road pose within seconds
     of the start and then follows it slowly.
@@ -38,7 +42,7 @@ def learn_neutral(
     yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s
     if yaw_deg is None or state.t_s is None:
         return yaw, pitch, yaw_s, pitch_s
-    ahead = abs(yaw_deg - yaw) <= config.road_half_width_deg
+    ahead = abs(yaw_deg - yaw) <= config.road_half_width_deg - config.hysteresis_deg
     level = pitch_deg is None or abs(pitch_deg) <= config.neutral_pitch_limit_deg
     if not (ahead and level):
         return yaw, pitch, yaw_s, pitch_s

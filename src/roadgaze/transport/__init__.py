@@ -26,6 +26,7 @@ from roadgaze.transport.payloads import (
     printable,
 )
 from roadgaze.transport.publisher import BusPublisher, MessageLink
+from roadgaze.transport.router import DEFAULT_LISTEN, Router, RouterSettings, router_config
 from roadgaze.transport.session import (
     SessionPlan,
     build_zenoh_config,
@@ -49,6 +50,7 @@ from roadgaze.transport.vss import (
 
 __all__ = [
     "ALERT_SCHEMA",
+    "DEFAULT_LISTEN",
     "MESSAGE_MAX_BYTES",
     "MESSAGE_MODELS",
     "SPEED_MAX_BYTES",
@@ -66,6 +68,8 @@ __all__ = [
     "MessageLink",
     "MonitorSnapshot",
     "PayloadError",
+    "Router",
+    "RouterSettings",
     "SessionPlan",
     "SpeedInput",
     "StateMessage",
@@ -86,6 +90,7 @@ __all__ = [
     "parse_vss_text",
     "plan_session",
     "printable",
+    "router_config",
     "vss_key",
     "vss_text",
     "vss_values",

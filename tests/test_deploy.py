@@ -1,0 +1,96 @@
+"""deploy/roadgaze.service: `systemd-analyze verify` says nothing about it (it exits 0 even on bad
+values, so its output is what counts), its hardening keeps the exposure score low, and the
+supervision settings are the ones the daemon implements."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from repo_paths import REPO
+
+UNIT = REPO / "deploy" / "roadgaze.service"
+INSTALLED_BINARY = "/opt/roadgaze/venv/bin/roadgaze"
+
+needs_systemd_analyze = pytest.mark.skipif(
+    shutil.which("systemd-analyze") is None, reason="systemd-analyze is not installed"
+)
+
+
+def unit_settings(text: str) -> dict[str, list[str]]:
+    """`Key=value` lines of a unit (every value of a repeated key), comments skipped."""
+    settings: dict[str, list[str]] = {}
+    for line in text.splitlines():
+        if line and not line.startswith(("#", ";", "[")) and "=" in line:
+            key, value = line.split("=", 1)
+            settings.setdefault(key.strip(), []).append(value.strip())
+    return settings
+
+
+def verify(unit_text: str, folder: Path) -> subprocess.CompletedProcess[str]:
+    """`systemd-analyze verify` on the unit, its ExecStart binary replaced by an executable stub
+    in `folder` (the real one is only on an installed machine); every other line is as written."""
+    stub = folder / "roadgaze"
+    stub.write_text("#!/bin/sh\n", encoding="utf-8")
+    stub.chmod(0o755)
+    assert INSTALLED_BINARY in unit_text
+    path = folder / "roadgaze.service"
+    path.write_text(unit_text.replace(INSTALLED_BINARY, str(stub)), encoding="utf-8")
+    return subprocess.run(
+        ["systemd-analyze", "verify", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+
+
+@needs_systemd_analyze
+def test_systemd_analyze_verify_says_nothing_about_the_unit(tmp_path: Path) -> None:
+    result = verify(UNIT.read_text(encoding="utf-8"), tmp_path)
+    assert (result.returncode, result.stdout + result.stderr) == (0, "")
+
+
+@needs_systemd_analyze
+def test_the_verify_check_catches_a_bad_value(tmp_path: Path) -> None:
+    """The control: a typo exits 0 too, but is reported; the test above would fail on it."""
+    broken = UNIT.read_text(encoding="utf-8").replace("Type=notify", "Type=notfy")
+    result = verify(broken, tmp_path)
+    assert "Failed to parse service type" in result.stdout + result.stderr
+
+
+@needs_systemd_analyze
+def test_the_hardening_keeps_the_exposure_score_at_most_2(tmp_path: Path) -> None:
+    shutil.copy(UNIT, tmp_path / "roadgaze.service")
+    result = subprocess.run(
+        ["systemd-analyze", "security", "--offline=true", "roadgaze.service"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    if "--offline" in result.stderr:
+        pytest.skip(f"this systemd-analyze has no --offline: {result.stderr.strip()}")
+    match = re.search(
+        r"Overall exposure level for roadgaze\.service: ([0-9.]+) (\w+)", result.stdout
+    )
+    assert match is not None, result.stdout[-2000:] + result.stderr
+    print(f"systemd-analyze security: {match.group(1)} {match.group(2)}")
+    assert float(match.group(1)) <= 2.0 and match.group(2) == "OK"
+
+
+def test_the_unit_asks_for_what_the_daemon_implements() -> None:
+    settings = unit_settings(UNIT.read_text(encoding="utf-8"))
+    assert settings["Type"] == ["notify"] and settings["NotifyAccess"] == ["main"]
+    assert settings["ExecStart"][0].startswith(f"{INSTALLED_BINARY} run --source ")
+    assert settings["KillSignal"] == ["SIGTERM"]
+    assert settings["WatchdogSec"] == ["20s"] and settings["TimeoutStartSec"] == ["90s"]
+    assert settings["RestartPreventExitStatus"] == ["2"]  # configuration errors: no restart loop
+    for hardening in ("ProtectSystem", "PrivateTmp", "NoNewPrivileges", "DevicePolicy"):
+        assert hardening in settings
+    assert settings["DeviceAllow"] == ["/dev/video0 rw"]

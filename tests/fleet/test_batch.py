@@ -208,6 +208,21 @@ def test_a_missing_ray_says_how_to_install_it(
     assert code == 2 and "pip install 'roadgaze[ray]'" in err and len(err.strip().splitlines()) == 1
 
 
+def test_a_missing_pyarrow_says_how_to_install_it_before_any_work(
+    local_batch: Any,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """pyarrow is the `fleet` extra: a daemon-only install answers `batch` with one line."""
+    monkeypatch.setitem(sys.modules, "pyarrow", None)
+    out = tmp_path / "out"
+    code = main(["batch", str(local_batch.input.folder), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and "pip install 'roadgaze[fleet]'" in err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()
+
+
 def test_a_folder_held_by_another_batch_is_refused(
     local_batch: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -77,7 +77,17 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
+FLEET_MISSING = (
+    "roadgaze batch writes Parquet and needs pyarrow, which is not installed: "
+    "pip install 'roadgaze[fleet]'"
+)
+
+
 def run(args: argparse.Namespace, config: Config) -> int:
+    try:
+        import pyarrow  # noqa: F401  (only asked whether it is there)
+    except ImportError:
+        raise ConfigError(FLEET_MISSING) from None
     from roadgaze.fleet import BatchOptions, discover_drives, run_batch
 
     if args.workers is not None and args.workers < 1:

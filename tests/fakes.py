@@ -27,6 +27,8 @@ from roadgaze.types import (
     Alert,
     ClosesOnExit,
     Detection,
+    EyeMeasurement,
+    EyesFeatures,
     FaceFeatures,
     Frame,
     FrameRecord,
@@ -90,6 +92,63 @@ class FakeCamera:
 
     def release(self) -> None:
         self.log.append("release")
+
+
+def eyes_of(
+    openness: float = 0.30,
+    blink: float | None = None,
+    eye_yaw: float = 0.0,
+    eye_pitch: float = 0.0,
+    usable: bool = True,
+    occluded: bool = False,
+) -> EyesFeatures:
+    """Both eyes alike: `openness` (lid gap / eye width), eyeBlink `blink` (None: 0.6 below
+    0.14, else 0.05), eye-in-head direction; `usable` False: a turned head (no eye)."""
+    if blink is None:
+        blink = 0.6 if openness < 0.14 else 0.05
+
+    def one(side: str) -> EyeMeasurement:
+        return EyeMeasurement(
+            side=side,
+            width_px=30.0,
+            openness=openness,
+            gaze_usable=usable and not occluded,
+            closure_usable=usable and not occluded,
+            reason="" if usable else "head turned",
+            yaw_deg=eye_yaw if usable else None,
+            pitch_deg=eye_pitch if usable else None,
+            blink=blink,
+            look_down=0.0,
+        )
+
+    return EyesFeatures(
+        right=one("right"),
+        left=one("left"),
+        method="blendshapes",
+        scale_px=30.0,
+        reason="" if usable else "head turned",
+        occluded=occluded,
+    )
+
+
+def open_eyes(openness: float = 0.3, direction: bool = False) -> EyesFeatures:
+    """Both eyes open and judged; with `direction`, looking straight ahead (eye yaw and pitch 0),
+    else giving no direction, so the monitor judges the zone on the head pose alone."""
+
+    def eye(side: str) -> EyeMeasurement:
+        return EyeMeasurement(
+            side=side,
+            width_px=30.0,
+            openness=openness,
+            gaze_usable=direction,
+            closure_usable=True,
+            yaw_deg=0.0 if direction else None,
+            pitch_deg=0.0 if direction else None,
+            blink=0.05,
+            look_down=0.0,
+        )
+
+    return EyesFeatures(right=eye("right"), left=eye("left"), method="blendshapes", scale_px=30.0)
 
 
 def face_at(yaw_deg: float, pitch_deg: float | None = None) -> FaceFeatures:

@@ -214,7 +214,7 @@ def test_replay_publish_one_long_distraction_three_seconds_into_the_glance(
     jsonschema.validate(yaws[100], SCHEMAS["yaw"])
     assert yaws[100]["on_road"] is False and yaws[30]["on_road"] is True
     assert (yaws[100]["zone"], yaws[100]["eyes_on_road"]) == ("lap", False)
-    assert yaws[30]["zone"] == "road" and yaws[100]["schema"] == "roadgaze.yaw/2"
+    assert yaws[30]["zone"] == "road" and yaws[100]["schema"] == "roadgaze.yaw/3"
     assert yaws[100]["pitch_deg"] - yaws[100]["neutral_pitch_deg"] < -25.0
     assert yaws[100]["t_s"] == pytest.approx(100 / CLIP_FPS, abs=1e-3)  # the video's timeline
     records = [json.loads(line) for line in (tmp_path / "frames.jsonl").read_text().splitlines()]

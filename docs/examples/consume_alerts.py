@@ -18,7 +18,17 @@ import zenoh
 from zenoh.ext import HistoryConfig, RecoveryConfig, declare_advanced_subscriber
 
 MAX_BYTES = 64 * 1024
-KINDS = {"long_distraction", "vats", "driver_unavailable", "cleared"}
+KINDS = {
+    "long_distraction",
+    "vats",
+    "driver_unavailable",
+    "microsleep",
+    "sleep",
+    "drowsy",
+    "unresponsive",
+    "degraded",
+    "cleared",
+}
 LEVELS = {"info", "warning", "critical"}
 
 
@@ -41,8 +51,8 @@ def check(raw: bytes, vehicle_id: str) -> dict | str:
         alert = json.loads(raw.decode("utf-8"))
     except (RecursionError, UnicodeDecodeError, ValueError) as exc:
         return f"not JSON ({type(exc).__name__})"
-    if not isinstance(alert, dict) or alert.get("schema") != "roadgaze.alert/1":
-        return "not a roadgaze.alert/1"
+    if not isinstance(alert, dict) or alert.get("schema") != "roadgaze.alert/2":
+        return "not a roadgaze.alert/2"
     if alert.get("vehicle_id") != vehicle_id:
         return "another vehicle's id"
     if type(alert.get("seq")) is not int or alert["seq"] < 0:

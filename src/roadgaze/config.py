@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING, Any, Literal, Self
 
 from pydantic import Field, ValidationError, field_validator, model_validator
 
+from roadgaze.config_eyes import EyeMonitorSettings
+from roadgaze.config_eyes import EyesConfig as EyesConfig
 from roadgaze.config_section import Section as _Section
 from roadgaze.config_zenoh import VEHICLE_ID_PATTERN as VEHICLE_ID_PATTERN
 from roadgaze.config_zenoh import ZenohConfig as ZenohConfig
@@ -177,7 +179,7 @@ def _default_zones() -> list[ZoneConfig]:
     ]
 
 
-class MonitorConfig(_Section):
+class MonitorConfig(EyeMonitorSettings):
     """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)
@@ -284,6 +286,7 @@ class Config(_Section):
     geometry: GeometryConfig = GeometryConfig()
     pose: PoseConfig = PoseConfig()
     landmarks: LandmarksConfig = LandmarksConfig()
+    eyes: EyesConfig = EyesConfig()
     capture: CaptureConfig = CaptureConfig()
     smoothing: SmoothingConfig = SmoothingConfig()
     monitor: MonitorConfig = MonitorConfig()

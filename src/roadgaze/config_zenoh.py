@@ -39,6 +39,11 @@ class ZenohConfig(Section):
     prefix: str = "vehicle/{vehicle_id}/dms"
     speed_key: str = "vehicle/{vehicle_id}/speed"
     """Key expression of the speed input; '' for none. Without a (fresh) speed: taken as moving."""
+    vss: bool = False
+    """Also publish the COVESA VSS driver signals (docs/zenoh.md), as `--vss` does."""
+    vss_prefix: str = Field(default="", pattern=r"^[^*$?#\s{}]*$")
+    """Key prefix of the VSS signals; '' publishes the bare VSS paths (one vehicle per network,
+    as Eclipse Kuksa assumes), e.g. 'car-0' gives car-0/Vehicle/Driver/IsEyesOnRoad."""
     speed_timeout_s: float = Field(default=2.0, gt=0)
     """No valid speed for this long (monotonic time) means unknown, taken as moving. The old
     name `speed_stale_s` is still accepted."""

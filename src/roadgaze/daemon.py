@@ -18,6 +18,7 @@ from roadgaze.config import Config
 from roadgaze.pipeline import Sink, SpeedSource, no_speed
 from roadgaze.signals import StopFlag, signal_handlers
 from roadgaze.transport import BusPublisher, Health, Keys, SpeedInput, ZenohLink
+from roadgaze.transport.vss import VSS_PATHS, VssPublisher, vss_key
 
 log = logging.getLogger("roadgaze.daemon")
 
@@ -43,15 +44,24 @@ def bus_outputs(config: Config, source_label: str, publish: bool) -> Iterator[Bu
         return
     speed = SpeedInput(config.zenoh.speed_timeout_s) if keys.speed is not None else None
     holder: list[Health] = []
-    link = ZenohLink(config.zenoh, keys, state_reply=lambda: holder[0].state_json(), speed=speed)
+    prefix = config.zenoh.vss_prefix
+    link = ZenohLink(
+        config.zenoh,
+        keys,
+        state_reply=lambda: holder[0].state_json(),
+        speed=speed,
+        vss_keys=tuple(vss_key(path, prefix) for path in VSS_PATHS) if config.zenoh.vss else (),
+    )
     health = Health(config, keys, link, source_label)
     holder.append(health)
-    publisher = BusPublisher(keys.vehicle_id, link)
+    sinks: tuple[Sink, ...] = (health, BusPublisher(keys.vehicle_id, link))
+    if config.zenoh.vss:
+        sinks = (*sinks, VssPublisher(link, config.monitor, prefix))
     with link:
         try:
             yield BusOutputs(
                 health=health,
-                sinks=(health, publisher),
+                sinks=sinks,
                 speed=speed.kmh if speed is not None else no_speed,
                 link=link,
             )

@@ -15,15 +15,16 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Generator, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from roadgaze.capture import FrameSource, SourceStatus
-from roadgaze.config import Config
+from roadgaze.config import Config, EyesConfig
 from roadgaze.handoff import Handoff
+from roadgaze.landmarks.eyes import driver_eyes
 from roadgaze.monitor import Monitor
 from roadgaze.pose import PoseEstimator
 from roadgaze.types import Detection, Frame, FrameRecord, LandmarkDetector
@@ -75,15 +76,8 @@ class StageTimes:
     total_ms: float
 
     def as_tuple(self) -> tuple[float, ...]:
-        return (
-            self.decode_ms,
-            self.landmarks_ms,
-            self.geometry_ms,
-            self.smoothing_ms,
-            self.monitor_ms,
-            self.sinks_ms,
-            self.total_ms,
-        )
+        """The times in `STAGES` order."""
+        return tuple(getattr(self, name) for name in self.__slots__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -207,8 +201,10 @@ class Pipeline:
         monitor: Monitor | None = None,
         speed: SpeedSource = no_speed,
         clock: Callable[[], float] = time.perf_counter,
+        eyes: EyesConfig | None = None,
     ) -> None:
         self.detector = detector
+        self.eyes = eyes if eyes is not None else EyesConfig()
         self.pose = pose if pose is not None else PoseEstimator()
         self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
         self.speed = speed
@@ -224,6 +220,7 @@ class Pipeline:
             pose=PoseEstimator.from_config(config),
             monitor=Monitor(config.monitor),
             speed=speed,
+            eyes=config.eyes,
         )
 
     @property
@@ -257,8 +254,10 @@ class Pipeline:
         yaw_raw_deg = self.pose.raw_yaw_deg(driver)
         # The matrix pitch's down gain starts at the monitor's current neutral pitch.
         pitch_raw_deg = self.pose.raw_pitch_deg(driver, self.monitor.state.neutral_pitch_deg)
+        eyes = driver_eyes(driver, yaw_raw_deg, self.eyes)
         after_geometry = clock()
         sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg, pitch_raw_deg)
+        sample = sample if eyes is None else replace(sample, eyes=eyes)
         after_smoothing = clock()
         alerts = self.monitor.update(sample, self.speed())
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)

@@ -14,13 +14,19 @@ up (the elevation of the face's forward direction).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from enum import StrEnum
 from types import TracebackType
 from typing import Protocol, Self
 
 import numpy as np
 import numpy.typing as npt
+
+from roadgaze.eye_records import EyeMeasurement as EyeMeasurement
+from roadgaze.eye_records import EyesFeatures as EyesFeatures
+from roadgaze.eye_records import EyeStatus as EyeStatus
+from roadgaze.eye_records import EyesVerdict as EyesVerdict
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -67,6 +73,13 @@ class FaceFeatures:
     """Roll-removed y of the bottom of the mid-line (chin, landmark 152)."""
     y_center_px: float | None = None
     """Roll-removed y of the mid-line's centre (nose tip, landmark 1): the pitch model's input."""
+    blendshapes: Mapping[str, float] | None = None
+    """MediaPipe's 52 blendshape scores (0..1) by their ARKit names, e.g. `eyeBlinkLeft`; the
+    names give the person's own side. None when the landmarker was not asked for them."""
+    eye_contrast: tuple[float, float] | None = None
+    """Contrast inside the (right, left) eye opening relative to the skin below the eye
+    (`roadgaze.landmarks.eyes.eye_contrast`; NaN where the eye is too small to measure); None
+    when not measured. Low in both eyes while the lids look open: sunglasses or an occlusion."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -112,6 +125,8 @@ class PoseSample:
     """Smoothed pitch; None before the first pitch or after the track was dropped."""
     roll_deg: float | None = None
     """Eye-line roll of this frame (> 0 = counter-clockwise in the image); None without a face."""
+    eyes: EyesFeatures | None = None
+    """The driver's eyes (roadgaze.landmarks.eyes); None without a face or eye measurement."""
 
 
 class AlertKind(StrEnum):
@@ -120,6 +135,12 @@ class AlertKind(StrEnum):
     LONG_DISTRACTION = "long_distraction"
     VATS = "vats"
     DRIVER_UNAVAILABLE = "driver_unavailable"
+    MICROSLEEP = "microsleep"
+    SLEEP = "sleep"
+    DROWSY = "drowsy"
+    UNRESPONSIVE = "unresponsive"
+    DEGRADED = "degraded"
+    """Monitoring impaired: the eyes have been unavailable too long (head pose only)."""
     CLEARED = "cleared"
 
 
@@ -156,6 +177,12 @@ class Alert:
     speed_kmh: float | None = None
     clears: tuple[AlertKind, ...] = ()
     """For `cleared`: the kinds of alert that were active."""
+    closure_s: float = 0.0
+    """Length of the current eye closure (for the closure alerts)."""
+    perclos: float | None = None
+    """Fraction of the last `perclos_window_s` with the eyes closed; None until enough is known."""
+    reason: str = ""
+    """Why the alert fired, in a few words (e.g. 'eyes closed', 'not back on road')."""
 
     @property
     def label(self) -> str:
@@ -198,6 +225,15 @@ class Verdict:
     distraction_s: float = 0.0
     """Time of the current off-road episode spent outside driving-related zones: the
     long-distraction timer."""
+    eyes: EyesVerdict = field(default_factory=EyesVerdict)
+    """The eyes: open, closed or unavailable, gaze, closure, PERCLOS, blinks."""
+
+    @property
+    def eyes_on_road(self) -> bool | None:
+        """Looking at the road with the eyes not closed; None when the gaze is unknown."""
+        if self.on_road is None:
+            return None
+        return self.on_road and self.eyes.status is not EyeStatus.CLOSED
 
 
 @dataclass(frozen=True, slots=True)

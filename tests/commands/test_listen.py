@@ -90,6 +90,49 @@ def test_hostile_payloads_are_reported_and_the_valid_alert_printed_once() -> Non
     assert "message rejected" in stderr and "limit 65536" in stderr
 
 
+def test_vss_values_from_the_bus_are_checked_before_they_are_printed() -> None:
+    port = free_port()
+    eyes_key = "Vehicle/Driver/IsEyesOnRoad"
+    with router(port) as attacker:
+        process = listen(port, "--vss", "--json", "--no-yaw", "--timeout", "30")
+        try:
+            reader = LineReader(process)
+            for _ in range(100):  # until the subscription has propagated
+                attacker.put(eyes_key, b"false")
+                line = reader.next(0.2)
+                if line is not None:
+                    break
+            assert line is not None
+            block = zenoh.CongestionControl.BLOCK
+            hostile = [
+                ("Vehicle/Driver/IsEyesOnRoad", b"yes"),
+                ("Vehicle/Driver/FatigueLevel", b"250.0"),  # outside 0-100 %
+                ("Vehicle/Driver/FatigueLevel", b"nan"),
+                ("Vehicle/Driver/DistractionLevel", b"1e308"),
+                ("Vehicle/Occupant/Row1/DriverSide/HeadPosition/Yaw", b"\xff\xfe"),
+                ("Vehicle/Cabin/Note", b"x" * 10_000),  # over the size limit: not even copied
+                ("Vehicle/Cabin/Note", b"\x1b[2J"),  # a terminal escape
+            ]
+            for key, payload in hostile:
+                attacker.put(key, payload, congestion_control=block)
+            attacker.put("Vehicle/Driver/FatigueLevel", b"60.0", congestion_control=block)
+            attacker.put("Vehicle/Speed", b"57.5", congestion_control=block)  # another provider's
+            received = [json.loads(reader.next(10.0) or "null") for _ in range(2)]
+            process.send_signal(signal.SIGTERM)
+            code = process.wait(timeout=20)
+            stderr = process.stderr.read() if process.stderr else ""
+        finally:
+            stop_process(process)
+    assert code == 0
+    assert "Traceback" not in stderr, stderr[-2000:]
+    assert json.loads(line) == {"type": "vss", "key": eyes_key, "value": "false"}
+    assert sorted((r["key"], r["value"]) for r in received) == [
+        ("Vehicle/Driver/FatigueLevel", "60.0"),
+        ("Vehicle/Speed", "57.5"),
+    ]
+    assert "message rejected" in stderr and "must be true or false" in stderr
+
+
 def test_pretty_printing_survives_lone_surrogates() -> None:
     port = free_port()
     with router(port) as attacker:

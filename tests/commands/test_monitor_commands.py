@@ -24,14 +24,22 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     assert {"yaw_deg", "off_road_s"} <= set(schemas["alert"]["properties"])
     yaw_fields = {"schema", "vehicle_id", "seq", "t_s", "frame", "face", "yaw_deg", "yaw_raw_deg"}
     assert yaw_fields | {"on_road"} <= set(schemas["yaw"]["properties"])
-    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/1"
+    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/2"
     # roadgaze.yaw/2 extends /1 with the pose and the zone; every field is always published
     new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
     assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
-    assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/2"
+    assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/3"
     assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/3"
     snapshot = schemas["state"]["$defs"]["MonitorSnapshot"]
     assert {"zone", "neutral_pitch_deg", "pitch_deg"} <= set(snapshot["required"])
+    # yaw/3 and state/3 add the eyes; alert/2 the closure and drowsiness kinds
+    eye_fields = {"eyes", "eye_openness", "gaze_yaw_deg", "gaze_pitch_deg", "gaze_source"}
+    eye_fields |= {"closure_s", "perclos", "blinks", "eyes_unavailable_s", "degraded"}
+    assert eye_fields <= set(schemas["yaw"]["required"])
+    assert eye_fields <= set(snapshot["required"])
+    kinds = set(schemas["alert"]["$defs"]["AlertKind"]["enum"])
+    assert {"microsleep", "sleep", "drowsy", "unresponsive", "degraded"} <= kinds
+    assert {"closure_s", "perclos", "reason"} <= set(schemas["alert"]["required"])
 
 
 def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
@@ -78,11 +86,54 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
             },
             "yaw    car-1 #9 t=0.30s     --   pitch     --   unknown",
         ),
+        (
+            "yaw",
+            {
+                "seq": 9,
+                "t_s": 0.3,
+                "yaw_deg": -1.2,
+                "pitch_deg": -11.1,
+                "zone": "centre_stack",
+                "eyes": "open",
+                "eye_openness": 0.171,
+                "gaze_yaw_deg": -20.8,
+                "gaze_pitch_deg": -22.8,
+                "gaze_source": "eyes",
+                "closure_s": 0.0,
+                "perclos": 0.04,
+                "degraded": False,
+            },
+            "yaw    car-1 #9 t=0.30s    -1.2° pitch   -11.1° centre_stack eyes open 0.17 "
+            "gaze -20.8°/-22.8° perclos 0.04",
+        ),
+        (
+            "yaw",
+            {"seq": 9, "t_s": 0.3, "yaw_deg": -1.0, "pitch_deg": -11.0, "zone": "road"}
+            | {"eyes": "closed", "eye_openness": 0.02, "closure_s": 1.8, "degraded": True},
+            "yaw    car-1 #9 t=0.30s    -1.0° pitch   -11.0° road eyes closed 0.02 closed 1.8s "
+            "DEGRADED",
+        ),
+        (
+            "alert",
+            {"seq": 4, "kind": "sleep", "level": "critical", "t_s": 12.6, "yaw_deg": -1.0}
+            | {"off_road_s": 0.0, "window_off_road_s": 0.0, "closure_s": 3.0}
+            | {"reason": "eyes closed 3.0 s"},
+            "ALERT  car-1 #4 sleep critical t=12.60s off_road=0.00s window=0.00s yaw=-1.0° "
+            "closure=3.00s (eyes closed 3.0 s)",
+        ),
         ("state", None, "state  car-1 undecodable payload: garbage"),
     ],
 )
 def test_listen_pretty_lines(kind: str, payload: dict[str, object] | None, expected: str) -> None:
     assert format_pretty(kind, "car-1", payload, "garbage") == expected
+
+
+def test_listen_vss_line() -> None:
+    from roadgaze.commands.listen import format_vss
+
+    assert format_vss("Vehicle/Driver/FatigueLevel", "60.0") == (
+        "vss    Vehicle/Driver/FatigueLevel = 60.0"
+    )
 
 
 def test_listen_finds_the_vehicle_in_the_key() -> None:

@@ -62,7 +62,12 @@ def test_group_figures_are_weighted_by_frames_and_time() -> None:
     assert alice.hours == pytest.approx(90.0 / 3600)
     assert alice.face_found_rate == pytest.approx((1800 + 450) / 2700)
     assert alice.off_road_ratio == pytest.approx((180 + 300) / (1800 + 600))
-    assert alice.alerts == {"long_distraction": 3, "vats": 1, "driver_unavailable": 1}
+    eye_kinds = ("microsleep", "sleep", "drowsy", "unresponsive", "degraded")
+    assert alice.alerts == {
+        "long_distraction": 3,
+        "vats": 1,
+        "driver_unavailable": 1,
+    } | dict.fromkeys(eye_kinds, 0)
     assert alice.alerts_per_h["long_distraction"] == pytest.approx(3 * 3600 / 90)
     assert alice.longest_off_road_s == 7.25
     assert alice.neutral_yaw_deg == pytest.approx(-1.0)

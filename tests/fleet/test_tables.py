@@ -137,7 +137,12 @@ def test_the_recorder_counts_an_escalated_alert_once(tmp_path: Path) -> None:
             recorder.on_record(record, None)  # type: ignore[arg-type]
         result = recorder.result(Drive("d1", tmp_path / "x.mp4"), 0.1, None, 50.0, 0.2)
         assert alert_writer.rows == 4
-    assert dict(result.alert_counts) == {"long_distraction": 1, "vats": 1, "driver_unavailable": 0}
+    eye_kinds = ("microsleep", "sleep", "drowsy", "unresponsive", "degraded")
+    assert dict(result.alert_counts) == {
+        "long_distraction": 1,
+        "vats": 1,
+        "driver_unavailable": 0,
+    } | dict.fromkeys(eye_kinds, 0)
     assert result.critical_alerts == 1
     assert (result.frames, result.frames_with_face) == (4, 3)
     assert result.duration_s == pytest.approx(0.4)

@@ -29,6 +29,7 @@ def landmarker(model_path: Path, video: bool, faces: int = 2) -> object:
         running_mode=mode,
         num_faces=faces,
         output_facial_transformation_matrixes=True,
+        output_face_blendshapes=True,
     )
     return vision.FaceLandmarker.create_from_options(options)
 
@@ -52,11 +53,15 @@ def test_direct_and_public_results_are_identical(model_path: Path, video: bool) 
             fast = run_landmarker(direct, image, timestamp)
             slow = run_landmarker(public, image, timestamp, direct=False)
             assert len(fast) == len(slow) == 2
-            for (points, matrix), (points_ref, matrix_ref) in zip(fast, slow, strict=True):
+            for (points, matrix, scores), (points_ref, matrix_ref, scores_ref) in zip(
+                fast, slow, strict=True
+            ):
                 assert points.shape == (478, 3) and points.dtype == np.float32
                 np.testing.assert_array_equal(points, points_ref)
                 assert matrix is not None and matrix_ref is not None
                 np.testing.assert_array_equal(matrix, matrix_ref)
+                assert scores is not None and len(scores) == 52 and scores == scores_ref
+                assert 0.0 <= scores["eyeBlinkLeft"] <= 1.0
             if not video:
                 break
     finally:
@@ -82,12 +87,13 @@ def test_objects_without_the_c_interface_use_the_public_api() -> None:
         def __init__(self) -> None:
             self.face_landmarks = [[Landmark()] * 3]
             self.facial_transformation_matrixes: list[np.ndarray] = []
+            self.face_blendshapes: list[object] = []
 
     class Public:
         def detect(self, image: object) -> Result:
             return Result()
 
     assert not uses_c_results(Public())
-    [(points, matrix)] = run_landmarker(Public(), object(), None)
+    [(points, matrix, scores)] = run_landmarker(Public(), object(), None)
     np.testing.assert_array_equal(points, np.tile([0.5, 0.25, -0.125], (3, 1)).astype(np.float32))
-    assert matrix is None
+    assert matrix is None and scores is None

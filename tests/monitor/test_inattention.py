@@ -8,6 +8,7 @@ from collections.abc import Callable
 
 import pytest
 
+from fakes import open_eyes
 from repo_paths import child_env
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor import (
@@ -45,6 +46,7 @@ def sample(
         n_faces=int(face),
         pitch_raw_deg=pitch_deg if face else None,
         pitch_deg=pitch_deg if face else None,
+        eyes=open_eyes() if face else None,
     )
 
 
@@ -91,6 +93,7 @@ def test_long_distraction_fires_three_seconds_into_a_glance_then_clears() -> Non
     assert_within_one_frame(alerts[0].t_s, 7.0)
     assert alerts[0].off_road_s == pytest.approx(3.0, abs=FRAME_S)
     assert alerts[0].yaw_deg == AWAY_YAW_DEG
+    assert alerts[0].reason == "head in away"
     assert_within_one_frame(alerts[1].t_s, 8.0)
     assert alerts[1].clears == (AlertKind.LONG_DISTRACTION,)
     assert alerts[1].off_road_s == pytest.approx(4.0, abs=FRAME_S)
@@ -101,11 +104,18 @@ def test_long_distraction_is_raised_to_critical_at_six_seconds() -> None:
     assert kinds(alerts) == [
         ("long_distraction", "warning"),
         ("long_distraction", "critical"),
+        ("unresponsive", "critical"),  # away 6 s, i.e. not back 3 s after the warning
         ("cleared", "info"),
     ]
     assert_within_one_frame(alerts[0].t_s, 4.0)
     assert_within_one_frame(alerts[1].t_s, 7.0)
-    assert_within_one_frame(alerts[2].t_s, 9.0)
+    assert_within_one_frame(alerts[2].t_s, 7.0)
+    assert alerts[2].reason == "away 6.0 s"
+    assert_within_one_frame(alerts[3].t_s, 9.0)
+    assert alerts[3].clears == (
+        AlertKind.LONG_DISTRACTION,
+        AlertKind.UNRESPONSIVE,
+    )
 
 
 def test_a_glance_shorter_than_three_seconds_raises_nothing() -> None:
@@ -320,10 +330,16 @@ def test_step_is_pure_and_ignores_time_going_backwards() -> None:
 
 def test_counters_and_levels() -> None:
     monitor, alerts = run(glances([0.5], 7.0), 9.0)
-    assert [a.level for a in alerts] == [AlertLevel.WARNING, AlertLevel.CRITICAL, AlertLevel.INFO]
+    assert [a.level for a in alerts] == [
+        AlertLevel.WARNING,
+        AlertLevel.CRITICAL,
+        AlertLevel.CRITICAL,
+        AlertLevel.INFO,
+    ]
     assert dict(monitor.state.alert_counts) == {
         "long_distraction:warning": 1,
         "long_distraction:critical": 1,
+        "unresponsive:critical": 1,
         "cleared:info": 1,
     }
     assert monitor.state.samples == 270

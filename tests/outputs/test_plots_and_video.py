@@ -112,10 +112,15 @@ def test_an_alert_stays_on_screen_until_cleared() -> None:
         0.0,
     )
     assert shown[5.5][0].elapsed_s == pytest.approx(1.5)
-    [critical] = shown[7.5]  # escalated at 6 s: the level changes, the time still counts
+    # escalated at 6 s: the level changes, the time still counts; away 6 s is also unresponsive
+    critical, unresponsive = shown[7.5]
     assert (critical.level, critical.elapsed_s) == (AlertLevel.CRITICAL, pytest.approx(3.5))
     assert critical.text == "LONG DISTRACTION  critical  3.5 s"
-    assert [b.kind for b in shown[7.9]] == [AlertKind.LONG_DISTRACTION]
+    assert (unresponsive.kind, unresponsive.elapsed_s) == (
+        AlertKind.UNRESPONSIVE,
+        pytest.approx(0.5),
+    )
+    assert [b.kind for b in shown[7.9]] == [AlertKind.LONG_DISTRACTION, AlertKind.UNRESPONSIVE]
     assert [b.kind for b in shown[8.0]] == [AlertKind.CLEARED]  # back on road
     assert [b.kind for b in shown[8.9]] == [AlertKind.CLEARED]
     assert shown[9.0] == []
@@ -142,5 +147,6 @@ def test_panel_lines_show_the_gaze_and_the_timers_against_their_thresholds() -> 
     lines = [line(record, FIXED) for line in PANEL_LINES]
     assert lines[2] == "zone AWAY  neutral +0.0/+0.0 deg  speed unknown (counting)"
     assert lines[3] == "off road 1.5 s  distraction 1.5/3 s  VATS window 1.5/10 s"
+    assert lines[4] == "eyes UNAVAILABLE (no eyes measured)  gaze +45/+0 deg (head)"
     without_thresholds = [line(record, None) for line in PANEL_LINES][3]
     assert without_thresholds == "off road 1.5 s  distraction 1.5 s  VATS window 1.5 s"

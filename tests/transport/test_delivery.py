@@ -30,8 +30,8 @@ from zenoh_helpers import (
 
 FPS = 10.0
 GLANCE = [0.0] * 10 + [-30.0] * 70 + [0.0] * 20
-"""Road 1 s, a 7 s glance to -30 deg (zone away: long_distraction at 4 s, critical at 7 s), road
-2 s."""
+"""Road 1 s, a 7 s glance to -30 deg (zone away: long_distraction at 4 s, critical and
+unresponsive, away 6 s, at 7 s), road 2 s."""
 
 
 @contextmanager
@@ -80,15 +80,15 @@ def test_router_killed_mid_glance_every_alert_arrives_in_order_soon_after_restar
             assert wait_for(lambda: listener.kinds() == ["long_distraction:warning"], 10.0)
             router.kill()
             assert wait_for(lambda: not link.status().connected, timeout_s=10.0)
-            feed(50, sinks)  # critical at 7 s, cleared at 8 s: both while the link is down
+            feed(50, sinks)  # critical, unresponsive at 7 s, cleared at 8 s: all while down
             down = link.status()
-            assert (down.alerts_sent, down.alerts_held_while_down) == (1, 2)
-            assert (down.alerts_published, down.link_downs) == (3, 1)
+            assert (down.alerts_sent, down.alerts_held_while_down) == (1, 3)
+            assert (down.alerts_published, down.link_downs) == (4, 1)
             assert listener.seqs() == [0]
             router.start()
             assert wait_for(lambda: link.status().connected, timeout_s=10.0)
-            assert wait_for(lambda: len(listener.seqs()) >= 3, timeout_s=5.0)
-            arrived = max(arrival for arrival, _ in listener.alerts[1:3])
+            assert wait_for(lambda: len(listener.seqs()) >= 4, timeout_s=5.0)
+            arrived = max(arrival for arrival, _ in listener.alerts[1:4])
             # The issue's figure: from the daemon's link coming back (its transport event). The
             # router process's start (Python and Zenoh loaded, then it listens) is printed too;
             # on a loaded machine that start alone can take seconds.
@@ -97,16 +97,17 @@ def test_router_killed_mid_glance_every_alert_arrives_in_order_soon_after_restar
                 f"outage alerts arrived {after_s:.3f} s after the daemon's link came back, "
                 f"{arrived - router.spawned_at:.3f} s after the router process was started"
             )
-            assert listener.seqs() == [0, 1, 2]
+            assert listener.seqs() == [0, 1, 2, 3]
             assert listener.kinds() == [
                 "long_distraction:warning",
                 "long_distraction:critical",
+                "unresponsive:critical",
                 "cleared:info",
             ]
             assert after_s <= 2.0
             assert listener.misses == []
             final = link.status()
-            assert (final.alerts_sent, final.alerts_held_while_down) == (1, 2)
+            assert (final.alerts_sent, final.alerts_held_while_down) == (1, 3)
             assert final.alerts_beyond_cache == 0 and final.not_sent >= 0
             listener.close()
     finally:

@@ -8,7 +8,7 @@ from collections.abc import Iterator
 import jsonschema
 import pytest
 
-from fakes import BLANK_FRAME, FakeLink, ListSource, ScriptedDetector
+from fakes import BLANK_FRAME, FakeLink, ListSource, ScriptedDetector, eyes_of
 from roadgaze.capture import SourceStatus
 from roadgaze.config import Config
 from roadgaze.monitor import Monitor
@@ -78,7 +78,7 @@ def test_yaw_message_from_a_record_keeps_every_value() -> None:
     assert (message.t_s, message.frame, message.face) == (39 / 30, 39, True)
     assert (message.yaw_deg, message.gaze, message.on_road) == (AWAY_YAW_DEG, "off_road", False)
     assert (message.zone, message.eyes_on_road) == ("away", False)
-    assert message.schema_id == "roadgaze.yaw/2"
+    assert message.schema_id == "roadgaze.yaw/3"
     assert json.loads(message.to_json_bytes())["gaze"] == "off_road"
 
 
@@ -114,6 +114,29 @@ def test_state_is_degraded_when_the_camera_or_zenoh_is_lost() -> None:
     health.source = None
     link.connected = False
     assert health.state_message().problems == ["zenoh not connected"]
+
+
+def test_state_is_degraded_while_the_eyes_have_been_unavailable_ten_seconds() -> None:
+    config = Config()
+    health = Health(config, Keys.from_config(config.zenoh), FakeLink(), "drive.mp4")
+    monitor = Monitor(config.monitor)
+    for frame in range(16 * 30):
+        t_s = frame / 30
+        eyes = eyes_of(usable=t_s >= 12.0)  # a turned head or sunglasses for 12 s, then back
+        sample_ = PoseSample(t_s, frame, True, 0.0, 0.0, 0.0, 1.0, n_faces=1, eyes=eyes)
+        alerts = monitor.update(sample_, None)
+        health.on_record(FrameRecord(sample_, monitor.verdict, alerts), BLANK_FRAME)
+        if frame == 11 * 30:
+            state = health.state_message()
+            assert state.status == "degraded" and state.monitor.degraded
+            assert state.problems == [
+                "eyes unavailable for 11 s (head turned): monitoring on head pose only"
+            ]
+            assert (state.monitor.eyes, state.monitor.gaze_source) == ("unavailable", "head")
+            jsonschema.validate(json.loads(state.to_json_bytes()), SCHEMAS["state"])
+    state = health.state_message()
+    assert (state.status, state.problems, state.monitor.eyes) == ("running", [], "open")
+    assert [a.kind for a in health.recent_alerts] == ["degraded", "cleared"]
 
 
 @pytest.mark.parametrize(

@@ -103,7 +103,7 @@ def test_schemas_validate_the_messages() -> None:
     jsonschema.validate(json.loads(yaw_message(3).to_json_bytes()), SCHEMAS["yaw"])
     alert = json.loads(alert_message().to_json_bytes())
     jsonschema.validate(alert, SCHEMAS["alert"])
-    assert alert["schema"] == "roadgaze.alert/1"
+    assert alert["schema"] == "roadgaze.alert/2"
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(alert | {"kind": "sneeze"}, SCHEMAS["alert"])
 
@@ -164,7 +164,7 @@ def test_subscriber_in_another_process_receives_valid_yaw_and_alert() -> None:
     yaw, alert = received[0]["payload"], received[-1]["payload"]
     jsonschema.validate(yaw, SCHEMAS["yaw"])
     jsonschema.validate(alert, SCHEMAS["alert"])
-    assert yaw["schema"] == "roadgaze.yaw/2" and yaw["vehicle_id"] == "test-car"
+    assert yaw["schema"] == "roadgaze.yaw/3" and yaw["vehicle_id"] == "test-car"
     assert alert["kind"] == "long_distraction" and alert["off_road_s"] == 3.0
     assert received[-1]["key"] == "vehicle/test-car/dms/alert"
     assert gone is not None and json.loads(gone)["payload"] == {"alive": False}

@@ -22,7 +22,15 @@ from repo_paths import child_env
 from roadgaze.config import Config, ZenohConfig
 from roadgaze.errors import ConfigError
 from roadgaze.security import init_bundle
-from roadgaze.transport import Health, Keys, SpeedInput, StateMessage, ZenohLink
+from roadgaze.transport import (
+    VSS_PATHS,
+    Health,
+    Keys,
+    SpeedInput,
+    StateMessage,
+    ZenohLink,
+    vss_key,
+)
 from roadgaze.types import PoseSample
 from zenoh_helpers import AdvancedListener, RouterProcess, free_port, router, wait_for
 
@@ -59,7 +67,13 @@ def daemon(secured: tuple[dict[str, Path], int]) -> Iterator[tuple[ZenohLink, Sp
     keys = Keys.from_config(config.zenoh)
     speed = SpeedInput(config.zenoh.speed_timeout_s)
     holder: list[Health] = []
-    link = ZenohLink(config.zenoh, keys, state_reply=lambda: holder[0].state_json(), speed=speed)
+    link = ZenohLink(
+        config.zenoh,
+        keys,
+        state_reply=lambda: holder[0].state_json(),
+        speed=speed,
+        vss_keys=tuple(vss_key(path) for path in VSS_PATHS),
+    )
     health = Health(config, keys, link, "test")
     holder.append(health)
     health.on_record(record_of(PoseSample(0.0, 0, True, 0.0, 0.0, 0.0, 1.0)), BLANK_FRAME)
@@ -170,6 +184,43 @@ def test_attacks_by_a_consumer_are_stopped_by_the_router(
         wide.undeclare()
         rogue.undeclare()
         listener.close()
+
+
+def test_only_the_daemon_may_put_vss_signals_and_consumers_receive_them(
+    secured: tuple[dict[str, Path], int], daemon: tuple[ZenohLink, SpeedInput]
+) -> None:
+    bundle, _ = secured
+    link, _ = daemon
+    key = vss_key("Vehicle.Driver.IsEyesOnRoad")
+    router_conf = json.loads(bundle["router"].read_text())
+    rules = {rule["id"]: rule for rule in router_conf["access_control"]["rules"]}
+    assert rules["daemon-vss"]["key_exprs"] == ["Vehicle/**"]
+    assert rules["consumer-vss-ask"]["messages"] == ["declare_subscriber"]
+    with (
+        zenoh.open(role_config(bundle, "consumer-fcw")) as fcw,
+        zenoh.open(role_config(bundle, "consumer-logger")) as attacker,
+    ):
+        received: list[tuple[str, bytes]] = []
+        subscriber = fcw.declare_subscriber(
+            "Vehicle/**", lambda s: received.append((str(s.key_expr), s.payload.to_bytes()))
+        )
+
+        def daemon_value_arrives() -> bool:
+            link.publish_vss(key, b"false")
+            time.sleep(0.1)
+            return (key, b"false") in received
+
+        assert wait_for(daemon_value_arrives, timeout_s=10.0, every_s=0.1)
+        block = zenoh.CongestionControl.BLOCK
+        for _ in range(5):  # a forged "eyes on the road" and an oversized value
+            attacker.put(key, b"true", congestion_control=block)
+            link.publish_vss(key, b"1" * 300)
+            time.sleep(0.1)
+        link.publish_vss(key, b"false")
+        time.sleep(0.5)
+        values = {payload for found, payload in received if found == key}
+        assert values == {b"false"}  # neither the forgery nor the oversized put got through
+        subscriber.undeclare()
 
 
 @pytest.mark.parametrize(

@@ -18,6 +18,8 @@ import sys
 import time
 from typing import Any
 
+from roadgaze.commands.listen_lines import format_pretty as format_pretty
+from roadgaze.commands.listen_lines import format_vss as format_vss
 from roadgaze.commands.options import (
     add_zenoh_options,
     check_seconds,
@@ -29,13 +31,16 @@ from roadgaze.transport.checks import vehicle_of
 
 log = logging.getLogger("roadgaze.listen")
 QUEUE_SIZE = 10_000
+VSS_MAX_BYTES = 256
+"""A VSS value is a short text; anything longer is refused unread."""
 
 
 def register(subparsers: Any) -> None:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "listen",
         parents=[common_options()],
-        help="print the yaw, alert, state and liveliness messages of one vehicle (or all)",
+        help="print the yaw, alert, state and liveliness messages of one vehicle (or all), and "
+        "with --vss the COVESA VSS signals",
         description="Subscribe to vehicle/<id>/dms/{yaw,alert,state} and the liveliness token "
         "vehicle/<id>/dms/alive and print each checked message: readable lines, or one JSON "
         "object per line with --json. Without --vehicle-id (or with '*') every vehicle is shown. "
@@ -44,7 +49,8 @@ def register(subparsers: Any) -> None:
         "--timeout S exits 1 when nothing was connected or received in S seconds. With "
         "--query-state, ask the state queryable once, print the answers and exit: 0 when every "
         "answer says running, 3 when one is degraded (or starting/stopping) or a vehicle "
-        "answered twice, 1 without an answer (a health check).",
+        "answered twice, 1 without an answer (a health check). With --vss, also the COVESA VSS "
+        "driver signals (Vehicle/**, under zenoh.vss_prefix), each value checked.",
     )
     add_zenoh_options(parser)
     parser.add_argument("--json", action="store_true", help="one JSON object per line")
@@ -57,42 +63,6 @@ def register(subparsers: Any) -> None:
 
 def _vehicle_of(key: str, prefix_template: str) -> str:
     return vehicle_of(key, prefix_template)
-
-
-def format_pretty(kind: str, vehicle: str, payload: dict[str, Any] | None, raw: str) -> str:
-    """One readable line for a received message."""
-    if payload is None:
-        return f"{kind:<6} {vehicle} undecodable payload: {raw[:120]}"
-    if kind == "alive":
-        return f"alive  {vehicle} {'joined' if payload.get('alive') else 'left'}"
-    if kind == "alert":
-        yaw = payload.get("yaw_deg")
-        yaw_text = "no face" if yaw is None else f"yaw={yaw:+.1f}°"
-        text = (
-            f"ALERT  {vehicle} #{payload.get('seq')} {payload.get('kind')} "
-            f"{payload.get('level')} t={payload.get('t_s', 0.0):.2f}s "
-            f"off_road={payload.get('off_road_s', 0.0):.2f}s "
-            f"window={payload.get('window_off_road_s', 0.0):.2f}s {yaw_text}"
-        )
-        if payload.get("clears"):
-            text += " clears=" + ",".join(payload["clears"])
-        return text
-    if kind == "yaw":
-        yaw = payload.get("yaw_deg")
-        yaw_text = "    --  " if yaw is None else f"{yaw:+7.1f}°"
-        line = f"yaw    {vehicle} #{payload.get('seq')} t={payload.get('t_s', 0.0):.2f}s {yaw_text}"
-        if "zone" not in payload:  # roadgaze.yaw/1
-            return f"{line} {payload.get('gaze')}"
-        pitch = payload.get("pitch_deg")
-        pitch_text = "    --  " if pitch is None else f"{pitch:+7.1f}°"
-        return f"{line} pitch {pitch_text} {payload.get('zone') or payload.get('gaze')}"
-    if kind == "state":
-        transport = payload.get("transport", {})
-        return (
-            f"state  {vehicle} status={payload.get('status')} frames={payload.get('frames')} "
-            f"alerts_sent={transport.get('alerts_sent')} problems={payload.get('problems')}"
-        )
-    return f"{kind:<6} {vehicle} {raw[:200]}"
 
 
 def _say(text: str) -> None:
@@ -144,6 +114,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
             return 1
         with session:
             listener = _Listener(args, zconf.prefix, keys, session, zconf.alert_cache_size)
+            if zconf.vss:
+                listener.vss_prefix = zconf.vss_prefix
             remaining_s = None if timeout_s is None else timeout_s - (time.monotonic() - started)
             try:
                 if args.query_state:
@@ -178,6 +150,8 @@ class _Listener:
         self.connected: set[str] = set()
         self.ever_connected = False
         self.warn = ThrottledWarning(log, "roadgaze listen: message rejected", period_s=5.0)
+        self.vss_prefix: str | None = None
+        """With --vss: the prefix of the VSS keys ('' for the bare paths); None: not shown."""
         self._sample_kind_put = zenoh.SampleKind.PUT
         self.entities: list[Any] = [
             session.info.declare_transport_events_listener(self._on_transport, history=True)
@@ -209,6 +183,12 @@ class _Listener:
         source = None if info is None else str(info.source_id)
         self._emit(kind, key, size if size > self.max_bytes else sample.payload.to_bytes(), source)
 
+    def _on_vss(self, sample: Any) -> None:
+        """O(1) like `_on_sample`; the value is checked when printed (the bus is untrusted)."""
+        size = len(sample.payload)
+        data = size if size > VSS_MAX_BYTES else sample.payload.to_bytes()
+        self._emit("vss", str(sample.key_expr), data)
+
     def _on_alive(self, sample: Any) -> None:
         alive = sample.kind == self._sample_kind_put
         self._emit("alive", str(sample.key_expr), json.dumps({"alive": alive}).encode())
@@ -235,6 +215,12 @@ class _Listener:
         self.entities.append(
             session.liveliness().declare_subscriber(keys.alive, self._on_alive, history=True)
         )
+        if self.vss_prefix is not None:
+            from roadgaze.transport import vss_key
+
+            self.entities.append(
+                session.declare_subscriber(vss_key("Vehicle.**", self.vss_prefix), self._on_vss)
+            )
         deadline = None if timeout_s is None else time.monotonic() + timeout_s
         printed = 0
         while not stop.is_set() and (self.args.count is None or printed < self.args.count):
@@ -265,6 +251,8 @@ class _Listener:
     def _print(self, kind: str, key: str, data: bytes | int, source: str | None) -> int:
         from roadgaze.transport import PayloadError, printable
 
+        if kind == "vss":
+            return self._print_vss(key, data)
         vehicle = vehicle_of(key, self.prefix_template)
         if kind == "missed":
             _say(
@@ -290,6 +278,22 @@ class _Listener:
                     f"{payload['seq']}"
                 )
         self._show(kind, key, vehicle, payload)
+        return 1
+
+    def _print_vss(self, key: str, data: bytes | int) -> int:
+        from roadgaze.transport import PayloadError, parse_vss_text, printable
+
+        try:
+            if isinstance(data, int):
+                raise PayloadError(f"{data} bytes, limit {VSS_MAX_BYTES}")
+            value = parse_vss_text(key, data, self.vss_prefix or "")
+        except PayloadError as exc:
+            self.warn(f"vss on {printable(key, 80)}: {printable(str(exc))}")
+            return 0
+        if self.args.json:
+            print(json.dumps({"type": "vss", "key": key, "value": value}), flush=True)
+        else:
+            print(format_vss(key, value), flush=True)
         return 1
 
     def _show(self, kind: str, key: str, vehicle: str, payload: dict[str, Any]) -> None:

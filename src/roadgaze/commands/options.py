@@ -63,6 +63,12 @@ def add_zenoh_options(parser: Any) -> None:
         help="endpoint to listen on (repeatable; peer mode)",
     )
     group.add_argument("--zenoh-mode", choices=["peer", "client"], help="zenoh session mode")
+    group.add_argument(
+        "--vss",
+        action="store_true",
+        help="also publish (run, replay --publish) or show (listen) the COVESA VSS driver "
+        "signals, e.g. Vehicle/Driver/IsEyesOnRoad (zenoh.vss)",
+    )
 
 
 def zenoh_config_from_args(config: ZenohConfig, args: Any) -> ZenohConfig:
@@ -81,6 +87,8 @@ def zenoh_config_from_args(config: ZenohConfig, args: Any) -> ZenohConfig:
         update["listen"] = list(args.zenoh_listen)
     if getattr(args, "zenoh_mode", None):
         update["mode"] = args.zenoh_mode
+    if getattr(args, "vss", False):
+        update["vss"] = True
     if not update:
         return config
     merged = {name: getattr(config, name) for name in config.model_fields_set} | update

@@ -24,8 +24,9 @@ def register(subparsers: Any) -> None:
         description="Write into DIR a certificate authority, one certificate per role and the "
         "Zenoh configuration files of the router (mutual TLS only, access control by "
         "certificate name, size and rate limits), the daemon, the speed provider and each "
-        "consumer. Only the daemon may publish under the vehicle's dms keys, only the speed "
-        "provider may publish its speed, consumers may only subscribe and query. Use them with "
+        "consumer. Only the daemon may publish under the vehicle's dms keys and the COVESA VSS "
+        "keys (Vehicle/**, under zenoh.vss_prefix), only the speed provider may publish its "
+        "speed, consumers may only subscribe and query. Use them with "
         "`roadgaze router --zenoh-config DIR/router/zenoh.json5` (or `zenohd -c` the same "
         "file), `roadgaze run --zenoh-config "
         "DIR/daemon/zenoh.json5` and `roadgaze listen --zenoh-config "
@@ -64,7 +65,7 @@ def register(subparsers: Any) -> None:
 
 def run_init(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.security import init_bundle
-    from roadgaze.transport import Keys
+    from roadgaze.transport import Keys, vss_key
 
     keys = Keys.from_config(config.zenoh, args.vehicle_id)
     written = init_bundle(
@@ -75,6 +76,7 @@ def run_init(args: argparse.Namespace, config: Config) -> int:
         listen=args.listen,
         path_root=args.path_root,
         force=args.force,
+        vss_keys=vss_key("Vehicle.**", config.zenoh.vss_prefix),
     )
     for role, path in written.items():
         print(f"{role:<20} {path}")

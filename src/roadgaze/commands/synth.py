@@ -43,16 +43,23 @@ def register(subparsers: Any) -> None:
         "yaw model recover it; --measure --pitch: a yaw x pitch grid of stills, pitch per |pitch| "
         "range and the zones; --measure-clip: render the timeline and print the raw, online and "
         "offline (RTS) yaw and pitch errors, the smoothers' overshoot, pitch per |pitch| range "
-        "and the zones against the truth.",
-        epilog="Timeline: comma-separated YAW[/PITCH]:SECONDS keyframes in degrees and seconds; "
-        "each segment turns to its pose during the first --transition seconds (cosine ease) and "
-        f"holds it. Example: {EXAMPLE_TIMELINE}. Yaw > 0: head turned to the person's own left.",
+        "and the zones against the truth; --measure --eyes: stills with the eyes turned and the "
+        "lids closed, the recovered eye direction and openness per bin and the closed/open "
+        "classifier against the truth.",
+        epilog="Timeline: comma-separated YAW[/PITCH][;FIELD=VALUE...]:SECONDS keyframes in "
+        "degrees and seconds; each segment turns to its pose during the first --transition "
+        f"seconds (cosine ease) and holds it. Example: {EXAMPLE_TIMELINE}. Yaw > 0: head turned "
+        "to the person's own left. Eye fields: eyes=open|closed|half|0..1, eye_yaw=DEG, "
+        "eye_pitch=DEG (within +-35; they move over --eye-transition), e.g. "
+        "'0:2,0;eyes=closed:1.5,0;eye_yaw=-25;eye_pitch=-30:2'; the truth CSV then also has "
+        "eye_yaw_deg,eye_pitch_deg,openness.",
     )
     parser.add_argument(
         "--timeline",
         default=EXAMPLE_TIMELINE,
         metavar="SPEC",
-        help=f"keyframes YAW[/PITCH]:SECONDS,... (default {EXAMPLE_TIMELINE}); with "
+        help=f"keyframes YAW[/PITCH][;FIELD=VALUE...]:SECONDS,... (default {EXAMPLE_TIMELINE}); "
+        "'eyes': a drive with a 1.5 s and a 4 s eye closure and an eyes-only glance; with "
         "--measure-clip also 'demo' (the demo's drive) or 'pose' (a yaw/pitch drive, the default)",
     )
     parser.add_argument("--out", type=Path, metavar="VIDEO", help="output .mp4, .avi or .mkv")
@@ -60,6 +67,13 @@ def register(subparsers: Any) -> None:
         "--photo", type=Path, help="portrait with one frontal face (default: skimage's astronaut)"
     )
     parser.add_argument("--fps", type=float, default=15.0, help="frames per second (default 15)")
+    parser.add_argument(
+        "--eye-transition",
+        type=float,
+        default=0.1,
+        metavar="SECONDS",
+        help="duration of each eye movement and lid closure between keyframes (default 0.1)",
+    )
     parser.add_argument(
         "--size", type=str, default="320x320", metavar="WxH", help="frame size (default 320x320)"
     )
@@ -88,6 +102,12 @@ def register(subparsers: Any) -> None:
         help="run the landmarker on each still in IMAGE mode (default: VIDEO mode over the sweep)",
     )
     measure.add_argument("--csv", type=Path, metavar="FILE", help="write per-yaw results here")
+    measure.add_argument(
+        "--eyes",
+        action="store_true",
+        help="with --measure: stills of rendered eyes (direction, openness, closed/open) at "
+        "640x480 unless --size is given; --csv writes one row per still",
+    )
     measure.add_argument(
         "--pitch",
         action="store_true",
@@ -150,6 +170,20 @@ def run(args: argparse.Namespace, config: Config) -> int:
         )
         print(format_clip_measurement(replace(clip, timeline=timeline)))
         return 0
+    if args.measure and args.eyes:
+        from roadgaze.synth import (
+            format_eye_measurement,
+            measure_eye_recovery,
+            write_eye_measurement_csv,
+        )
+
+        eye_size = size if args.size != "320x320" else (640, 480)
+        eye_result = measure_eye_recovery(config, args.photo, eye_size)
+        print(format_eye_measurement(eye_result))
+        if args.csv is not None:
+            write_eye_measurement_csv(args.csv, eye_result)
+            print(f"wrote {args.csv}")
+        return 0
     if args.measure and args.pitch:
         from roadgaze.synth import format_pitch_measurement, measure_pitch_recovery
 
@@ -177,7 +211,12 @@ def run(args: argparse.Namespace, config: Config) -> int:
         return 0
     if args.out is None:
         raise ConfigError("--out VIDEO is required to render a clip (or pass --measure)")
-    timeline = parse_timeline(args.timeline, args.transition)
+    spec = args.timeline
+    if spec == "eyes":
+        from roadgaze.synth import EYE_DRIVE_TIMELINE
+
+        spec = EYE_DRIVE_TIMELINE
+    timeline = parse_timeline(spec, args.transition, args.eye_transition)
     load_photo(args.photo)  # fail fast on a bad photo before any work
     truth = render_clip(timeline, args.out, photo=args.photo, fps=args.fps, size=size)
     log.info(

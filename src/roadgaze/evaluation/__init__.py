@@ -1,5 +1,12 @@
-"""Evaluation: pose on still images scored against ground truth, and the paper's experiments."""
+"""Evaluation: pose and eyes on stills scored against ground truth, the paper's experiments."""
 
+from roadgaze.evaluation.eyes import (
+    EyeEstimate,
+    EyeReport,
+    evaluate_eyes,
+    format_eye_report,
+    still_eyes,
+)
 from roadgaze.evaluation.ground_truth import GroundTruth, load_ground_truth
 from roadgaze.evaluation.images import (
     MODEL_NAMES,
@@ -48,6 +55,8 @@ __all__ = [
     "SERVICE",
     "ErrorStats",
     "EvaluationReport",
+    "EyeEstimate",
+    "EyeReport",
     "GroundTruth",
     "ImageEstimate",
     "PitchReport",
@@ -59,7 +68,9 @@ __all__ = [
     "estimate_image",
     "estimate_images",
     "evaluate",
+    "evaluate_eyes",
     "evaluate_pitch",
+    "format_eye_report",
     "format_landmark_comparison",
     "format_pitch_report",
     "format_refit",
@@ -70,6 +81,7 @@ __all__ = [
     "refit_constants",
     "rescore_landmark_choice",
     "save_plot",
+    "still_eyes",
     "write_predictions",
     "write_report",
     "yaw_by_model",

@@ -17,6 +17,8 @@ class GroundTruth:
     file: str
     yaw_deg: float
     pitch_deg: float | None = None
+    subject: str | None = None
+    """Who is in the image, when the file has a `subject` column (for leave-half-out checks)."""
 
 
 def load_ground_truth(dataset_dir: Path) -> tuple[list[GroundTruth], int]:
@@ -57,7 +59,8 @@ def load_ground_truth(dataset_dir: Path) -> tuple[list[GroundTruth], int]:
                 if pitch_deg is not None and abs(pitch_deg) == 90.0:
                     skipped += 1
                     continue
-                rows.append(GroundTruth(row["file"], yaw_deg, pitch_deg))
+                subject = (row.get("subject") or "").strip() or None
+                rows.append(GroundTruth(row["file"], yaw_deg, pitch_deg, subject))
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise DatasetError(f"cannot read {csv_path}: {exc}") from None
     if not rows:

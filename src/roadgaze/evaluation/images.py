@@ -19,6 +19,7 @@ import numpy.typing as npt
 
 from roadgaze.config import Config, LandmarksConfig
 from roadgaze.errors import SourceError
+from roadgaze.evaluation.eyes import EyeEstimate, still_eyes
 from roadgaze.monitor.zones import ZoneMap
 from roadgaze.pose.estimator import PoseEstimator
 from roadgaze.pose.geometry import PAPER_CONSTANTS, YAW_MODELS, FaceModelConstants
@@ -61,6 +62,8 @@ class ImageEstimate:
     """The vertical CE model's pitch (P4), for comparison."""
     zone: str | None = None
     """The glance zone of the service's yaw and pitch (neutral 0, no previous zone)."""
+    eyes: EyeEstimate | None = None
+    """The eyes as the service judges them on a still (roadgaze.evaluation.eyes)."""
 
     @property
     def yaw_deg(self) -> float | None:
@@ -143,10 +146,12 @@ class StillPose:
 
     pose: PoseEstimator
     zones: ZoneMap
+    config: Config = field(default_factory=Config)
+    """For the eyes: `[eyes]` and the monitor's eye thresholds."""
 
     @classmethod
     def from_config(cls, config: Config) -> StillPose:
-        return cls(PoseEstimator.from_config(config), config.monitor.zone_map())
+        return cls(PoseEstimator.from_config(config), config.monitor.zone_map(), config)
 
     def estimate(self, face: FaceFeatures) -> tuple[float | None, float | None, str | None]:
         """Yaw, pitch and zone of one face as a first sample with neutral 0."""
@@ -179,6 +184,7 @@ def estimate_from_detection(
         still = StillPose(PoseEstimator(constants=constants), Config().monitor.zone_map())
     service_yaw, pitch, zone = still.estimate(driver)
     return ImageEstimate(
+        eyes=still_eyes(driver, service_yaw, pitch, still.config),
         service_yaw_deg=service_yaw,
         pitch_deg=pitch,
         pitch_geometric_deg=_geometric_pitch(driver),

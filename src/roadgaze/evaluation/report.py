@@ -12,7 +12,7 @@ from __future__ import annotations
 import csv
 import json
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.evaluation.eyes import EyeEstimate, EyeReport, evaluate_eyes, format_eye_report
 from roadgaze.evaluation.ground_truth import GroundTruth
 from roadgaze.evaluation.images import MODEL_NAMES, ImageEstimate
 from roadgaze.evaluation.pitch import PitchReport, evaluate_pitch, format_pitch_report
@@ -58,8 +59,14 @@ PREDICTION_COLUMNS: tuple[str, ...] = (
     "zone",
     "pitch_mediapipe",
     "pitch_geometric",
+    "gaze_yaw_deg",
+    "gaze_pitch_deg",
+    "eye_openness",
+    "eyes_closed",
 )
-"""`yaw_deg`, `pitch_deg`, `zone`: the service's (neutral 0); `roll_deg`: the eye line's."""
+"""`yaw_deg`, `pitch_deg`, `zone`: the service's (neutral 0); `roll_deg`: the eye line's;
+`gaze_*`: head + eyes (the head alone where the eyes give no direction); `eye_openness`: lid gap
+/ eye width; `eyes_closed`: 1 closed, 0 open, empty when the eyes cannot be judged."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -112,6 +119,7 @@ class EvaluationReport:
     bins: tuple[BinStats, ...]
     refit: Mapping[str, Any] | None = None
     pitch: PitchReport | None = None
+    eyes: EyeReport | None = None
 
     def to_json_dict(self) -> dict[str, Any]:
         return {
@@ -138,6 +146,7 @@ class EvaluationReport:
             ],
             "refit": self.refit,
             "pitch": None if self.pitch is None else self.pitch.to_json_dict(),
+            "eyes": None if self.eyes is None else self.eyes.to_json_dict(),
         }
 
 
@@ -184,6 +193,7 @@ def evaluate(
         ranges=ranges,
         bins=tuple(bins),
         pitch=evaluate_pitch(truths, estimates),
+        eyes=evaluate_eyes(truths, estimates),
     )
 
 
@@ -231,6 +241,9 @@ def format_report(report: EvaluationReport) -> str:
     if report.pitch is not None:
         lines.append("")
         lines.append(format_pitch_report(report.pitch))
+    if report.eyes is not None:
+        lines.append("")
+        lines.append(format_eye_report(report.eyes))
     if report.refit is not None:
         lines.append("")
         from roadgaze.evaluation.refit import format_refit
@@ -256,7 +269,15 @@ def write_predictions(path: Path, estimates: Iterable[ImageEstimate]) -> None:
                 + [cell(e.mediapipe_yaw_deg), cell(e.yaw_deg), cell(e.pitch_deg)]
                 + [cell(e.roll_deg), e.zone or ""]
                 + [cell(e.mediapipe_pitch_deg), cell(e.pitch_geometric_deg)]
+                + _eye_cells(e.eyes, cell)
             )
+
+
+def _eye_cells(eyes: EyeEstimate | None, cell: Callable[[float | None], str]) -> list[str]:
+    if eyes is None:
+        return ["", "", "", ""]
+    closed = "" if eyes.closed is None else str(int(eyes.closed))
+    return [cell(eyes.gaze_yaw_deg), cell(eyes.gaze_pitch_deg), cell(eyes.openness), closed]
 
 
 def write_report(path: Path, report: EvaluationReport) -> None:

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from roadgaze.landmarks.eyes import swap_sides
 from roadgaze.types import FaceFeatures
 
 DRIVER_SWITCH_AREA_RATIO = 1.25
@@ -89,11 +90,21 @@ def unmirror(face: FaceFeatures, image_width_px: int) -> FaceFeatures:
         y_top_px=face.y_top_px,
         y_bottom_px=face.y_bottom_px,
         y_center_px=face.y_center_px,
+        blendshapes=None if face.blendshapes is None else swap_sides(face.blendshapes),
+        eye_contrast=None if face.eye_contrast is None else face.eye_contrast[::-1],
     )
 
 
 def _mean(a: float | None, b: float | None) -> float | None:
     return None if a is None or b is None else 0.5 * (a + b)
+
+
+def _mean_scores(
+    a: Mapping[str, float] | None, b: Mapping[str, float] | None
+) -> Mapping[str, float] | None:
+    if a is None or b is None:
+        return a if b is None else b
+    return {name: 0.5 * (score + b.get(name, score)) for name, score in a.items()}
 
 
 def merge_mirrored(
@@ -102,7 +113,8 @@ def merge_mirrored(
     """Average each face with its measurement in the flipped image (matched by box overlap).
 
     The result is exactly mirror-symmetric: flipping the input negates every yaw. A face found in
-    only one of the two images is kept as found there.
+    only one of the two images is kept as found there. Blendshape scores are averaged (the
+    mirrored face's Left and Right swapped); landmarks and eye contrast stay the original's.
     """
     candidates = [unmirror(face, image_width_px) for face in mirrored_faces]
     merged: list[FaceFeatures] = []
@@ -127,6 +139,8 @@ def merge_mirrored(
                 y_top_px=_mean(face.y_top_px, other.y_top_px),
                 y_bottom_px=_mean(face.y_bottom_px, other.y_bottom_px),
                 y_center_px=_mean(face.y_center_px, other.y_center_px),
+                blendshapes=_mean_scores(face.blendshapes, other.blendshapes),
+                eye_contrast=face.eye_contrast,
             )
         )
     return merged + candidates

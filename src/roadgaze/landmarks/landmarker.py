@@ -7,7 +7,7 @@ by `LandmarksConfig.driver` (see `roadgaze.landmarks.driver`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +16,8 @@ import numpy.typing as npt
 
 from roadgaze.config import Config, LandmarksConfig
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored
+from roadgaze.landmarks.eye_contrast import eye_contrast
+from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
 from roadgaze.landmarks.features import DEFAULT_CHOICE, LandmarkChoice, features_from_landmarks
 from roadgaze.landmarks.multi_face import (
     FaceCounter,
@@ -48,6 +50,13 @@ def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
     else:
         raise ValueError(f"expected a grayscale, BGR or BGRA image, found shape {array.shape}")
     return np.ascontiguousarray(rgb)
+
+
+def rgb_to_gray(rgb: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
+    """The grey image the eye check measures (OpenCV's luma weights)."""
+    import cv2
+
+    return np.asarray(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY), dtype=np.uint8)
 
 
 @dataclass(frozen=True, slots=True)
@@ -131,6 +140,7 @@ class MediaPipeLandmarker(ClosesOnExit):
             min_face_presence_confidence=config.min_presence_confidence,
             min_tracking_confidence=config.min_tracking_confidence,
             output_facial_transformation_matrixes=True,
+            output_face_blendshapes=True,
         )
         return vision.FaceLandmarker.create_from_options(options)
 
@@ -188,13 +198,13 @@ class MediaPipeLandmarker(ClosesOnExit):
         elif t_s is not None:
             raise ValueError("IMAGE mode takes no timestamp; construct with video=True")
         if self._switch is not None and t_s is not None:
-            faces = self._run_switching(mp_image, rgb.shape, t_s, timestamp_ms)
+            faces = self._run_switching(mp_image, rgb, t_s, timestamp_ms)
         else:
-            faces = self._run(self._landmarker, mp_image, rgb.shape, timestamp_ms)
+            faces = self._run(self._landmarker, mp_image, rgb, timestamp_ms)
         if self._mirror_landmarker is not None:
             flipped = np.ascontiguousarray(rgb[:, ::-1])
             mirrored_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=flipped)
-            mirrored = self._run(self._mirror_landmarker, mirrored_image, rgb.shape, timestamp_ms)
+            mirrored = self._run(self._mirror_landmarker, mirrored_image, flipped, timestamp_ms)
             faces = merge_mirrored(faces, mirrored, rgb.shape[1])
         if not self._video:
             return Detection(tuple(faces), choose_driver(faces, self._config.driver))
@@ -205,7 +215,7 @@ class MediaPipeLandmarker(ClosesOnExit):
         return Detection(faces=tuple(faces), driver_index=driver_index)
 
     def _run_switching(
-        self, mp_image: Any, shape: tuple[int, ...], t_s: float, timestamp_ms: int | None
+        self, mp_image: Any, rgb: npt.NDArray[np.uint8], t_s: float, timestamp_ms: int | None
     ) -> list[FaceFeatures]:
         """One frame of a stream: the one-face landmarker unless a count sees several faces."""
         switch, counter = self._switch, self._counter
@@ -213,20 +223,20 @@ class MediaPipeLandmarker(ClosesOnExit):
         if switch.check_due(t_s):
             switch.counted(t_s, counter.count(mp_image))
         if switch.mode is FaceMode.SINGLE:
-            faces = self._run(self._single_landmarker, mp_image, shape, timestamp_ms)
+            faces = self._run(self._single_landmarker, mp_image, rgb, timestamp_ms)
             if not faces and switch.previous_box is not None:
                 # Tracking was lost on this frame. MediaPipe would look for a face only on the
                 # next one; look again now (its detector runs once it tracks no face), as the
                 # multi-face landmarker, which detects on every frame, would have.
-                faces = self._run(self._single_landmarker, mp_image, shape, self._next_ms())
+                faces = self._run(self._single_landmarker, mp_image, rgb, self._next_ms())
             box = faces[0].box_px if faces else None
             if not switch.jumped(t_s, box):
                 return faces
             switch.counted(t_s, counter.count(mp_image))
             if not switch.multi:
                 return faces
-            return self._run(self._landmarker, mp_image, shape, self._next_ms())
-        return self._run(self._landmarker, mp_image, shape, timestamp_ms)
+            return self._run(self._landmarker, mp_image, rgb, self._next_ms())
+        return self._run(self._landmarker, mp_image, rgb, timestamp_ms)
 
     def _next_ms(self) -> int:
         """A further MediaPipe timestamp within the current frame (a second call on it)."""
@@ -237,10 +247,12 @@ class MediaPipeLandmarker(ClosesOnExit):
         self,
         landmarker: Any,
         mp_image: Any,
-        shape: tuple[int, ...],
+        rgb: npt.NDArray[np.uint8],
         timestamp_ms: int | None,
     ) -> list[FaceFeatures]:
-        height, width = shape[:2]
+        """The faces of one run, each with its blendshapes and the contrast of its eye openings
+        (measured on `rgb`, the image `mp_image` holds)."""
+        height, width = rgb.shape[:2]
         scale = np.array([width, height, width], np.float32)
         if id(landmarker) in self._started:
             results = run_landmarker(landmarker, mp_image, timestamp_ms)
@@ -249,13 +261,17 @@ class MediaPipeLandmarker(ClosesOnExit):
                 results = run_landmarker(landmarker, mp_image, timestamp_ms)
             self._started.add(id(landmarker))
         faces: list[FaceFeatures] = []
-        for points, matrix in results:
+        gray: npt.NDArray[np.uint8] | None = None
+        for points, matrix, blendshapes in results:
+            pixels = points * scale
             try:
-                faces.append(
-                    features_from_landmarks(points * scale, (width, height), matrix, self._choice)
-                )
+                features = features_from_landmarks(pixels, (width, height), matrix, self._choice)
             except ValueError:
                 continue
+            if gray is None:
+                gray = rgb_to_gray(rgb)
+            contrast = (eye_contrast(gray, pixels, RIGHT_EYE), eye_contrast(gray, pixels, LEFT_EYE))
+            faces.append(replace(features, blendshapes=blendshapes, eye_contrast=contrast))
         return faces
 
     def close(self) -> None:

@@ -19,9 +19,12 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-FaceArrays = tuple[npt.NDArray[np.float32], npt.NDArray[np.float64] | None]
+Blendshapes = dict[str, float]
+"""MediaPipe's blendshape scores of one face by category name (`eyeBlinkLeft`: 0..1)."""
+FaceArrays = tuple[npt.NDArray[np.float32], npt.NDArray[np.float64] | None, Blendshapes | None]
 """One face: (N, 3) landmarks x, y, z as MediaPipe normalises them (x, y in 0..1 of the image
-width and height, z in the scale of x), and the 4x4 facial transformation matrix or None."""
+width and height, z in the scale of x), the 4x4 facial transformation matrix or None, and the
+blendshape scores or None (a landmarker made without `output_face_blendshapes`)."""
 
 
 class _CResultReader:
@@ -45,7 +48,13 @@ class _CResultReader:
         layout_ok = (
             (landmark_type.x.offset, landmark_type.y.offset, landmark_type.z.offset) == (0, 4, 8)
             and ctypes.sizeof(landmark_type) % 4 == 0
-            and {"face_landmarks", "face_landmarks_count", "facial_transformation_matrixes"}
+            and {
+                "face_landmarks",
+                "face_landmarks_count",
+                "facial_transformation_matrixes",
+                "face_blendshapes",
+                "face_blendshapes_count",
+            }
             <= {name for name, *_ in result_type._fields_}
         )
         return cls(result_type, landmark_type) if layout_ok else None
@@ -56,18 +65,33 @@ class _CResultReader:
             result.facial_transformation_matrixes[i].to_numpy()
             for i in range(result.facial_transformation_matrixes_count)
         ]
+        blendshapes = [
+            _scores(result.face_blendshapes[i]) for i in range(result.face_blendshapes_count)
+        ]
         for i in range(result.face_landmarks_count):
             face = result.face_landmarks[i]
             count = int(face.landmarks_count)
+            scores = blendshapes[i] if i < len(blendshapes) else None
             if count == 0:
-                faces.append((np.empty((0, 3), np.float32), None))
+                faces.append((np.empty((0, 3), np.float32), None, scores))
                 continue
             pointer = ctypes.cast(face.landmarks, ctypes.POINTER(ctypes.c_float))
             flat = np.ctypeslib.as_array(pointer, shape=(count * self.floats_per_landmark,))
             points = flat.reshape(count, self.floats_per_landmark)[:, :3].copy()
             matrix = np.asarray(matrices[i], np.float64) if i < len(matrices) else None
-            faces.append((points, matrix))
+            faces.append((points, matrix, scores))
         return faces
+
+
+def _scores(categories: Any) -> Blendshapes:
+    """The scores of one face's C category list (52 entries: name and score each)."""
+    found: Blendshapes = {}
+    for j in range(int(categories.categories_count)):
+        category = categories.categories[j]
+        name = category.category_name
+        if name:
+            found[name.decode("utf-8", "replace")] = float(category.score)
+    return found
 
 
 @functools.cache
@@ -105,11 +129,16 @@ def run_landmarker(
     else:
         result = landmarker.detect_for_video(image, timestamp_ms)
     matrices = result.facial_transformation_matrixes or []
+    blendshape_lists = result.face_blendshapes or []
     faces: list[FaceArrays] = []
     for index, face in enumerate(result.face_landmarks):
         points = np.array([(p.x, p.y, p.z) for p in face], dtype=np.float32).reshape(-1, 3)
         matrix = np.asarray(matrices[index], np.float64) if index < len(matrices) else None
-        faces.append((points, matrix))
+        scores = blendshape_lists[index] if index < len(blendshape_lists) else None
+        blendshapes = (
+            None if scores is None else {str(c.category_name): float(c.score) for c in scores}
+        )
+        faces.append((points, matrix, blendshapes))
     return faces
 
 

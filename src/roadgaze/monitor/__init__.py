@@ -1,5 +1,7 @@
 """Inattention monitor: glance zones and a pure time-based state machine, samples to verdicts."""
 
+from roadgaze.monitor.eye_rules import classify_eyes, eye_zone_map, gaze_deg, soft_threshold
+from roadgaze.monitor.eyes import EyeMonitorState, step_eyes
 from roadgaze.monitor.inattention import Monitor, step, verdict_of
 from roadgaze.monitor.state import MonitorState, distraction_s, initial_state
 from roadgaze.monitor.zones import (
@@ -21,15 +23,21 @@ __all__ = [
     "Alert",
     "AlertKind",
     "AlertLevel",
+    "EyeMonitorState",
     "Gaze",
     "Monitor",
     "MonitorState",
     "Verdict",
     "Zone",
     "ZoneMap",
+    "classify_eyes",
     "classify_zone",
     "distraction_s",
+    "eye_zone_map",
+    "gaze_deg",
     "initial_state",
+    "soft_threshold",
     "step",
+    "step_eyes",
     "verdict_of",
 ]

@@ -25,7 +25,17 @@ Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monit
   critical at `critical_distraction_s`.
 - `vats`: off-road time (every zone but road) within the last `vats_window_s` reaches
   `vats_threshold_s`; fires once and is re-armed after `vats_rearm_s` continuously on road.
-- `cleared`: the first on-road sample with a face after any of the above.
+- eyes (`roadgaze.monitor.eyes`): open, closed or unavailable per sample; with the eyes open and
+  giving a direction the zone is judged on the gaze (head + eyes beyond `gaze_deadband_deg`)
+  against a road `eyes_road_margin_deg` narrower, so an eyes-only glance counts; otherwise
+  (eyes closed or unavailable) on the head pose. Closures raise `microsleep`, `sleep` and
+  `unresponsive`; PERCLOS and long blinks `drowsy`; eyes unavailable `degraded`.
+- `unresponsive` on the distraction path: away (outside the road and driving-related zones)
+  `unresponsive_away_s`, or not back on the road `unresponsive_after_warning_s` after a
+  `long_distraction` or `vats` warning.
+- `cleared`: the first on-road sample with a face and eyes not closed after any distraction
+  alert; a closure's alerts once the eyes are open on the road again; `drowsy` once re-armed;
+  `degraded` once the eyes are back.
 - speed gating: time off road or unavailable counts only while the vehicle moves faster than
   `min_speed_kmh` (`speed_kmh` None means unknown and is taken as moving), so no alert fires
   below that speed.
@@ -41,6 +51,10 @@ import math
 from dataclasses import dataclass, replace
 
 from roadgaze.config import MonitorConfig
+from roadgaze.monitor.escalation import split_cleared, unresponsive_check
+from roadgaze.monitor.eye_rules import eye_zone_map
+from roadgaze.monitor.eyes import step_eyes
+from roadgaze.monitor.neutral import learn_neutral
 from roadgaze.monitor.state import (
     EPS_S,
     MonitorState,
@@ -50,12 +64,18 @@ from roadgaze.monitor.state import (
     window_total,
 )
 from roadgaze.monitor.zones import AWAY, ROAD, ZoneMap
-from roadgaze.types import Alert, AlertKind, AlertLevel, Gaze, PoseSample, Verdict
+from roadgaze.types import (
+    Alert,
+    AlertKind,
+    AlertLevel,
+    EyeStatus,
+    EyesVerdict,
+    Gaze,
+    PoseSample,
+    Verdict,
+)
 
 __all__ = ["Monitor", "MonitorState", "initial_state", "step", "verdict_of"]
-
-_MAX_LEARNING_STEP_S = 1.0
-"""A longer gap between samples teaches the neutral pose no more than one second would."""
 
 
 def _finite(smoothed: float | None, raw: float | None) -> float | None:
@@ -76,16 +96,50 @@ class _Look:
     pitch_deg: float | None
     lost_since_s: float | None
     turned_away: bool
+    by_eyes: bool = False
+
+    @property
+    def why(self) -> str:
+        """Why the driver counts as off road, for the alert's `reason`."""
+        if self.turned_away:
+            return f"face out of view, last seen in {self.zone}"
+        return f"{'eyes' if self.by_eyes else 'head'} in {self.zone}"
+
+
+def _eyes_moved(eyes: EyesVerdict, head_yaw_deg: float, head_pitch_deg: float) -> bool:
+    """The eyes give the gaze and have moved beyond the deadband (gaze != head pose)."""
+    return (
+        eyes.gaze_source == "eyes"
+        and eyes.gaze_yaw_deg is not None
+        and eyes.gaze_pitch_deg is not None
+        and (eyes.gaze_yaw_deg != head_yaw_deg or eyes.gaze_pitch_deg != head_pitch_deg)
+    )
 
 
 def _classify(
-    config: MonitorConfig, zones: ZoneMap, state: MonitorState, sample: PoseSample, t_s: float
+    config: MonitorConfig,
+    zones: ZoneMap,
+    state: MonitorState,
+    sample: PoseSample,
+    t_s: float,
+    eyes: EyesVerdict,
 ) -> _Look:
     yaw = _finite(sample.yaw_deg, sample.yaw_raw_deg) if sample.face else None
     pitch = _finite(sample.pitch_deg, sample.pitch_raw_deg) if sample.face else None
     if sample.face:
         if yaw is None:  # a face whose yaw the model cannot explain: keep the last decision
             zone = state.face_zone
+        elif _eyes_moved(
+            eyes, yaw, state.neutral_pitch_deg if pitch is None else pitch
+        ):  # an eye glance: judged on the gaze, narrower road
+            gaze_zones = eye_zone_map(zones, config.eyes_road_margin_deg)
+            zone = gaze_zones.classify(
+                (eyes.gaze_yaw_deg or 0.0) - state.neutral_yaw_deg,
+                (eyes.gaze_pitch_deg or 0.0) - state.neutral_pitch_deg,
+                state.face_zone,
+            )
+            gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
+            return _Look(gaze, zone, zone, yaw, pitch, None, False, by_eyes=True)
         else:
             pitch_offset = 0.0 if pitch is None else pitch - state.neutral_pitch_deg
             zone = zones.classify(yaw - state.neutral_yaw_deg, pitch_offset, state.face_zone)
@@ -105,47 +159,6 @@ def _classify(
     if zone == ROAD or zones.is_driving_related(zone):  # out of view: no longer a mirror glance
         zone = AWAY
     return _Look(Gaze.OFF_ROAD, zone, zone, None, None, lost_since, True)
-
-
-def _learn(value: float, neutral: float, gain: float, limit: float) -> float:
-    return max(-limit, min(limit, neutral + gain * (value - neutral)))
-
-
-def _learn_neutral(
-    config: MonitorConfig, state: MonitorState, look: _Look, t_s: float
-) -> tuple[float, float, float, float]:
-    """The neutral yaw and pitch after this sample and the time each has learned from.
-
-    A sample teaches when the head looks ahead: its yaw within the road's entry bound
-    (`road_half_width_deg - hysteresis_deg`) of the neutral yaw, and its pitch within
-    +-`neutral_pitch_limit_deg` (where a neutral pitch may lie). The pitch test is wider than the
-    road zone, so a camera above or below the line of sight, whose road pose reads outside the
-    road zone at first, is still learned. The yaw test is not: a sample in the hysteresis band
-    may be a glance held just past the road's edge, and learning from it would walk the neutral
-    after the glance until the glance reads as road (fail-safe: an alert is never learned
-    away). The gain is the larger of
-    the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
-    over the time learned so far): the neutral settles on the driver's road pose within seconds
-    of the start and then follows it slowly.
-    """
-    yaw, pitch = state.neutral_yaw_deg, state.neutral_pitch_deg
-    yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s
-    if look.yaw_deg is None or state.t_s is None:
-        return yaw, pitch, yaw_s, pitch_s
-    ahead = abs(look.yaw_deg - yaw) <= config.road_half_width_deg - config.hysteresis_deg
-    level = look.pitch_deg is None or abs(look.pitch_deg) <= config.neutral_pitch_limit_deg
-    if not (ahead and level):
-        return yaw, pitch, yaw_s, pitch_s
-    dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
-    slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)
-    if config.neutral_yaw_deg is None:
-        gain = max(slow_gain, dt_s / (yaw_s + dt_s))
-        yaw, yaw_s = _learn(look.yaw_deg, yaw, gain, config.neutral_limit_deg), yaw_s + dt_s
-    if config.neutral_pitch_deg is None and look.pitch_deg is not None:
-        gain = max(slow_gain, dt_s / (pitch_s + dt_s))
-        pitch = _learn(look.pitch_deg, pitch, gain, config.neutral_pitch_limit_deg)
-        pitch_s += dt_s
-    return yaw, pitch, yaw_s, pitch_s
 
 
 def _count(counts: tuple[tuple[str, int], ...], alerts: list[Alert]) -> tuple[tuple[str, int], ...]:
@@ -175,9 +188,19 @@ def step(
     if not math.isfinite(t_s) or (state.t_s is not None and t_s <= state.t_s):
         return state, ()
     zones = zones if zones is not None else config.zone_map()
-    look = _classify(config, zones, state, sample, t_s)
-    gaze, yaw = look.gaze, look.yaw_deg
     moving = speed_kmh is None or speed_kmh > config.min_speed_kmh
+    head_pitch = _finite(sample.pitch_deg, sample.pitch_raw_deg)
+    eyes, eye_events = step_eyes(
+        config,
+        state.eyes,
+        sample,
+        moving,
+        state.on_road,
+        _finite(sample.yaw_deg, sample.yaw_raw_deg) if sample.face else None,
+        state.neutral_pitch_deg if head_pitch is None else head_pitch,
+    )
+    look = _classify(config, zones, state, sample, t_s, eyes.verdict)
+    gaze, yaw = look.gaze, look.yaw_deg
     alerts: list[Alert] = []
 
     # Continuous off-road episode, its distraction time and the VATS window (while moving).
@@ -221,7 +244,9 @@ def step(
             unavailable_alerted = False
     unavailable_s = 0.0 if unavailable_since is None else t_s - unavailable_since
 
-    def alert(kind: AlertKind, level: AlertLevel, clears: tuple[AlertKind, ...] = ()) -> Alert:
+    def alert(
+        kind: AlertKind, level: AlertLevel, clears: tuple[AlertKind, ...] = (), reason: str = ""
+    ) -> Alert:
         return Alert(
             kind=kind,
             level=level,
@@ -232,6 +257,9 @@ def step(
             unavailable_s=unavailable_s,
             speed_kmh=speed_kmh,
             clears=clears,
+            closure_s=eyes.closure_s(),
+            perclos=eyes.verdict.perclos,
+            reason=reason,
         )
 
     active = list(state.active)
@@ -240,15 +268,16 @@ def step(
             distraction_now_s >= config.critical_distraction_s - EPS_S
             and long_level is not AlertLevel.CRITICAL
         ):
-            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.CRITICAL))
+            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.CRITICAL, reason=look.why))
             long_level = AlertLevel.CRITICAL
         elif distraction_now_s >= config.long_distraction_s - EPS_S and long_level is None:
-            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING))
+            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING, reason=look.why))
             long_level = AlertLevel.WARNING
 
     vats_armed = state.vats_armed
     on_since = state.on_since_s
     on_with_face = gaze is Gaze.ON_ROAD and sample.face
+    looking = on_with_face and eyes.status is not EyeStatus.CLOSED
     if on_with_face:
         on_since = t_s if on_since is None else on_since
         if not vats_armed and t_s - on_since >= config.vats_rearm_s - EPS_S:
@@ -267,15 +296,23 @@ def step(
         alerts.append(alert(AlertKind.DRIVER_UNAVAILABLE, AlertLevel.WARNING))
         unavailable_alerted = True
 
-    if on_with_face and active:
-        alerts.append(alert(AlertKind.CLEARED, AlertLevel.INFO, clears=tuple(active)))
-        active = []
+    for kind, level, reason in eye_events:
+        alerts.append(alert(kind, level, reason=reason))
+    away_unresponsive = state.away_unresponsive and off_since is not None
+    warned_since, away_unresponsive, unresponsive = unresponsive_check(
+        config, state, alerts, t_s, moving, looking, distraction_now_s, away_unresponsive
+    )
+    if unresponsive:
+        alerts.append(alert(AlertKind.UNRESPONSIVE, AlertLevel.CRITICAL, reason=unresponsive))
+    cleared, active = split_cleared(active, eyes, looking)
+    if cleared:
+        alerts.append(alert(AlertKind.CLEARED, AlertLevel.INFO, clears=cleared))
     for raised in alerts:
         if raised.kind is not AlertKind.CLEARED and raised.kind not in active:
             active.append(raised.kind)
 
-    neutral_yaw, neutral_pitch, yaw_learned_s, pitch_learned_s = _learn_neutral(
-        config, state, look, t_s
+    neutral_yaw, neutral_pitch, yaw_learned_s, pitch_learned_s = learn_neutral(
+        config, state, look.yaw_deg, look.pitch_deg, t_s
     )
     new_state = replace(
         state,
@@ -308,6 +345,9 @@ def step(
         active=tuple(active),
         samples=state.samples + 1,
         alert_counts=_count(state.alert_counts, alerts),
+        eyes=eyes,
+        warned_since_s=warned_since,
+        away_unresponsive=away_unresponsive,
     )
     return new_state, tuple(alerts)
 
@@ -315,6 +355,7 @@ def step(
 def verdict_of(config: MonitorConfig, state: MonitorState) -> Verdict:
     """The monitor's view after the last sample, as the frame record carries it."""
     return Verdict(
+        eyes=state.eyes.verdict,
         gaze=state.gaze,
         on_road=None if state.gaze is Gaze.UNKNOWN else state.zone == ROAD,
         yaw_deg=state.yaw_deg,

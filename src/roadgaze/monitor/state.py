@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from roadgaze.config import MonitorConfig
+from roadgaze.monitor.eyes import EyeMonitorState
 from roadgaze.monitor.zones import ROAD
 from roadgaze.types import AlertKind, AlertLevel, Gaze
 
@@ -67,6 +68,12 @@ class MonitorState:
     """Alerts raised and not yet cleared, in the order they were raised."""
     samples: int = 0
     alert_counts: tuple[tuple[str, int], ...] = field(default=())
+    eyes: EyeMonitorState = field(default_factory=EyeMonitorState)
+    """The eyes: closure, blinks, PERCLOS, gaze, unavailable time (roadgaze.monitor.eyes)."""
+    warned_since_s: float | None = None
+    """When a distraction warning asked the driver to look back and they have not yet."""
+    away_unresponsive: bool = False
+    """`unresponsive` was raised for the current off-road episode."""
 
     @property
     def on_road(self) -> bool:

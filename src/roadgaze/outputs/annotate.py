@@ -20,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from roadgaze.config import MonitorConfig
+from roadgaze.outputs.annotate_eyes import draw_eyes, eyes_line
 from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
 from roadgaze.types import (
     AlertKind,
@@ -186,8 +187,8 @@ def annotate(
     monitor: MonitorConfig | None = None,
     banners: Sequence[Banner] = (),
 ) -> npt.NDArray[np.uint8]:
-    """A copy of `image` with the face geometry, a yaw gauge, the `PANEL_LINES` and the banners
-    drawn."""
+    """A copy of `image` with the face geometry, the eyes (a box per eye, the gaze arrow), a yaw
+    gauge, the `PANEL_LINES` and the banners drawn."""
     import cv2
 
     canvas = image.copy()
@@ -213,6 +214,7 @@ def annotate(
             ends = roll_frame.to_image(np.array([[x_px, top], [x_px, bottom]]))
             (x0, y0), (x1, y1) = ends
             cv2.line(canvas, (round(x0), round(y0)), (round(x1), round(y1)), colour, thickness)
+    draw_eyes(canvas, record, scale)
     gauge_width = _draw_gauge(canvas, sample, scale)
     _draw_banners(canvas, banners, scale, thickness, width - gauge_width)
     lines_text = [line(record, monitor) for line in PANEL_LINES]
@@ -323,7 +325,7 @@ def timers_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
 
 
 PanelLine = Callable[[FrameRecord, MonitorConfig | None], str]
-PANEL_LINES: tuple[PanelLine, ...] = (yaw_line, state_line, gaze_line, timers_line)
+PANEL_LINES: tuple[PanelLine, ...] = (yaw_line, state_line, gaze_line, timers_line, eyes_line)
 """The text lines at the bottom of each frame, top to bottom."""
 
 

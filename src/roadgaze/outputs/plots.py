@@ -20,7 +20,16 @@ import numpy as np
 
 from roadgaze.config import MonitorConfig
 from roadgaze.errors import RoadgazeError
-from roadgaze.types import Alert, AlertKind, ClosesOnExit, FloatArray, Frame, FrameRecord, Gaze
+from roadgaze.types import (
+    Alert,
+    AlertKind,
+    ClosesOnExit,
+    EyeStatus,
+    FloatArray,
+    Frame,
+    FrameRecord,
+    Gaze,
+)
 
 ALERT_COLOURS = {"warning": "tab:orange", "critical": "tab:red", "info": "tab:green"}
 MAX_LABEL_ROWS = 8
@@ -51,6 +60,12 @@ SERIES: tuple[Series, ...] = (
            {"color": "tab:orange"}),
     Series("off road in the VATS window", lambda r: r.verdict.window_off_road_s, "timers",
            {"color": "tab:purple"}),
+    Series("gaze (eyes)", lambda r: _eye_gaze_yaw_deg(r), "yaw", {"color": "tab:green", "lw": 1}),
+    Series("eyes closed, this closure", lambda r: r.verdict.eyes.closure_s, "timers",
+           {"color": "tab:brown", "lw": 0.8}),
+    Series("openness", lambda r: r.verdict.eyes.openness, "eyes",
+           {"ls": "", "marker": ".", "markersize": 3, "color": "tab:blue"}),
+    Series("PERCLOS", lambda r: r.verdict.eyes.perclos, "eyes", {"color": "tab:orange", "lw": 1}),
 )  # fmt: skip
 """What is plotted; a new record field (eyes, ...) joins with one line here (and a panel in
 `PANELS` if it needs a new one)."""
@@ -58,12 +73,22 @@ SERIES: tuple[Series, ...] = (
 PANELS = {
     "yaw": "yaw (deg, + = driver's left)",
     "pitch": "pitch (deg, + = up)",
-    "timers": "off-road time (s)",
+    "timers": "off-road and closed time (s)",
+    "eyes": "eyes (lid gap / width)",
 }
 """The value panels, top to bottom, with their y labels; a panel whose values are all missing
 (pitch from an old record) is left out."""
 TRUTH_COLUMNS = {"yaw": 1, "pitch": 2}
 """Column of the truth array (`t_s, yaw_deg, pitch_deg`) drawn in each panel."""
+TRUTH_OPENNESS_COLUMN, OPEN_EYE_GAP = 5, 0.3
+"""A synthetic clip's true openness (a fraction of the photo's own; `roadgaze synth`), drawn
+scaled to the lid gap of an open eye (about 0.3 of its width, docs/eyes.md)."""
+
+
+def _eye_gaze_yaw_deg(record: FrameRecord) -> float | None:
+    """The gaze yaw where the eyes gave it (None where it is the head's)."""
+    eyes = record.verdict.eyes
+    return eyes.gaze_yaw_deg if eyes.gaze_source == "eyes" else None
 
 
 def label_rows(spans: Sequence[tuple[float, float]], gap: float = 0.0) -> list[int]:
@@ -157,6 +182,7 @@ class YawPlot(ClosesOnExit):
         self.neutral_deg: list[float] = []
         self.neutral_pitch_deg: list[float] = []
         self.gaze: list[Gaze] = []
+        self.eye_status: list[EyeStatus] = []
         self.alerts: list[Alert] = []
         self.label_boxes: list[tuple[float, float, float, float]] = []
         self.unlabelled_alerts = 0
@@ -186,6 +212,7 @@ class YawPlot(ClosesOnExit):
         self.neutral_deg.append(record.verdict.neutral_yaw_deg)
         self.neutral_pitch_deg.append(record.verdict.neutral_pitch_deg)
         self.gaze.append(record.verdict.gaze)
+        self.eye_status.append(record.verdict.eyes.status)
         self.alerts.extend(record.alerts)
 
     def close(self) -> None:
@@ -219,6 +246,8 @@ class YawPlot(ClosesOnExit):
             self._draw_pitch(axes["pitch"], t_s)
         if "timers" in axes:
             self._draw_timers(axes["timers"])
+        if "eyes" in axes:
+            self._draw_eyes(axes["eyes"], t_s)
         for name, column in TRUTH_COLUMNS.items():
             if name in axes and self.truth is not None and self.truth.shape[1] > column:
                 axes[name].plot(self.truth[:, 0], self.truth[:, column], "-", color="black",
@@ -285,12 +314,26 @@ class YawPlot(ClosesOnExit):
             (self.monitor.long_distraction_s, "long distraction", "tab:orange"),
             (self.monitor.critical_distraction_s, "critical", "tab:red"),
             (self.monitor.vats_threshold_s, "VATS", "tab:purple"),
+            (self.monitor.microsleep_s, "microsleep", "tab:brown"),
+            (self.monitor.sleep_s, "sleep", "tab:brown"),
         )
         for seconds, name, colour in thresholds:
             axes.axhline(seconds, color=colour, lw=0.7, ls=":")
             axes.annotate(f"{name} {seconds:g} s", (1.0, seconds),
                           xycoords=("axes fraction", "data"), ha="right", va="bottom",
                           fontsize=6, color=colour)  # fmt: skip
+
+    def _draw_eyes(self, axes: Any, t_s: FloatArray) -> None:
+        """Closed and unavailable stretches shaded; a synthetic clip's true openness."""
+        for status, colour in ((EyeStatus.CLOSED, "tab:red"), (EyeStatus.UNAVAILABLE, "tab:gray")):
+            for number, (first, last) in enumerate(_runs([e is status for e in self.eye_status])):
+                end = t_s[last + 1] if last + 1 < len(t_s) else t_s[last]
+                axes.axvspan(t_s[first], end, color=colour, alpha=0.12, lw=0,
+                             label=f"eyes {status.value}" if number == 0 else None)  # fmt: skip
+        truth = self.truth
+        if truth is not None and truth.shape[1] > TRUTH_OPENNESS_COLUMN:
+            axes.plot(truth[:, 0], OPEN_EYE_GAP * truth[:, TRUTH_OPENNESS_COLUMN], "-",
+                      color="black", lw=1, label=f"truth x{OPEN_EYE_GAP:g}")  # fmt: skip
 
     def _draw_alert_labels(self, figure: Any, events: Any) -> None:
         """One label per alert in the top strip, in rows so that none overlaps another."""

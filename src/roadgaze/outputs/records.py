@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from roadgaze.errors import RoadgazeError
-from roadgaze.types import Alert, ClosesOnExit, Frame, FrameRecord
+from roadgaze.types import Alert, ClosesOnExit, EyesVerdict, Frame, FrameRecord
 
 
 class FieldType(StrEnum):
@@ -57,13 +57,28 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("off_road_s", FieldType.FLOAT),
     ("window_off_road_s", FieldType.FLOAT),
     ("distraction_s", FieldType.FLOAT),
+    ("eyes", FieldType.STR),
+    ("eyes_reason", FieldType.STR),
+    ("eye_openness", FieldType.FLOAT),
+    ("eye_yaw_deg", FieldType.FLOAT),
+    ("eye_pitch_deg", FieldType.FLOAT),
+    ("gaze_yaw_deg", FieldType.FLOAT),
+    ("gaze_pitch_deg", FieldType.FLOAT),
+    ("gaze_source", FieldType.STR),
+    ("closure_s", FieldType.FLOAT),
+    ("perclos", FieldType.FLOAT),
+    ("blinks", FieldType.INT),
+    ("long_blinks", FieldType.INT),
+    ("eyes_unavailable_s", FieldType.FLOAT),
+    ("degraded", FieldType.BOOL),
     ("alerts", FieldType.STR_LIST),
     ("yaw_offline_deg", FieldType.FLOAT),
     ("pitch_offline_deg", FieldType.FLOAT),
 )
 """Every field of `record_fields`, in order, with its type: the one description the writers and
-the fleet's Parquet schema are derived from (x_* in pixels of the roll-removed frame). A field
-added to `record_fields` is added here too (a test checks it)."""
+the fleet's Parquet schema are derived from (x_* in pixels of the roll-removed frame; the eye
+fields as `roadgaze.types.EyesVerdict` defines them, `eyes` is open, closed or unavailable). A
+field added to `record_fields` is added here too (a test checks it)."""
 
 RECORD_FIELDS = tuple(name for name, _ in RECORD_SCHEMA)
 """The fields of `record_fields`, in order. `yaw_offline_deg` / `pitch_offline_deg` are null
@@ -81,6 +96,9 @@ ALERT_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("unavailable_s", FieldType.FLOAT),
     ("speed_kmh", FieldType.FLOAT),
     ("clears", FieldType.STR_LIST),
+    ("closure_s", FieldType.FLOAT),
+    ("perclos", FieldType.FLOAT),
+    ("reason", FieldType.STR),
 )
 """Every field of `alert_fields`: the content of an `AlertMessage` without its wire fields."""
 
@@ -115,12 +133,13 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "on_road": verdict.on_road,
         "gaze": verdict.gaze.value,
         "zone": verdict.zone,
-        "eyes_on_road": verdict.on_road,
+        "eyes_on_road": verdict.eyes_on_road,
         "neutral_yaw_deg": round(verdict.neutral_yaw_deg, 3),
         "neutral_pitch_deg": round(verdict.neutral_pitch_deg, 3),
         "off_road_s": round(verdict.off_road_s, 3),
         "window_off_road_s": round(verdict.window_off_road_s, 3),
         "distraction_s": round(verdict.distraction_s, 3),
+        **eye_fields(verdict.eyes),
         "alerts": [alert.label for alert in record.alerts],
         "yaw_offline_deg": None,
         "pitch_offline_deg": None,
@@ -139,6 +158,29 @@ def alert_fields(alert: Alert) -> dict[str, Any]:
         "unavailable_s": round(max(0.0, alert.unavailable_s), 3),
         "speed_kmh": rounded(alert.speed_kmh, 3),
         "clears": [kind.value for kind in alert.clears],
+        "closure_s": round(max(0.0, alert.closure_s), 3),
+        "perclos": rounded(alert.perclos, 4),
+        "reason": alert.reason,
+    }
+
+
+def eye_fields(eyes: EyesVerdict) -> dict[str, Any]:
+    """The eye part of the record (`eyes` ... `degraded` in RECORD_SCHEMA)."""
+    return {
+        "eyes": eyes.status.value,
+        "eyes_reason": eyes.reason,
+        "eye_openness": rounded(eyes.openness, 3),
+        "eye_yaw_deg": rounded(eyes.eye_yaw_deg, 2),
+        "eye_pitch_deg": rounded(eyes.eye_pitch_deg, 2),
+        "gaze_yaw_deg": rounded(eyes.gaze_yaw_deg, 2),
+        "gaze_pitch_deg": rounded(eyes.gaze_pitch_deg, 2),
+        "gaze_source": eyes.gaze_source,
+        "closure_s": round(eyes.closure_s, 3),
+        "perclos": rounded(eyes.perclos, 4),
+        "blinks": eyes.blinks,
+        "long_blinks": eyes.long_blinks,
+        "eyes_unavailable_s": round(eyes.unavailable_s, 3),
+        "degraded": eyes.degraded,
     }
 
 

@@ -25,7 +25,7 @@ from typing import Any
 
 from roadgaze.errors import ConfigError
 from roadgaze.security.certificates import CertificateAuthority, Issued
-from roadgaze.security.policy import access_control, downsampling, low_pass_filter
+from roadgaze.security.policy import VSS_KEYS, access_control, downsampling, low_pass_filter
 from roadgaze.transport.keys import Keys
 
 CONSUMER_NAME = re.compile(r"[A-Za-z0-9_-]{1,32}")
@@ -60,15 +60,19 @@ def _transport(folder: Path, *, server: bool) -> dict[str, Any]:
 
 
 def router_config(
-    folder: Path, listen: str, keys: Keys, common_names: dict[str, list[str]]
+    folder: Path,
+    listen: str,
+    keys: Keys,
+    common_names: dict[str, list[str]],
+    vss_keys: str = VSS_KEYS,
 ) -> dict[str, Any]:
     return {
         "mode": "router",
         "listen": {"endpoints": [listen]},
         "scouting": {"multicast": {"enabled": False}, "gossip": {"enabled": False}},
         "transport": _transport(folder, server=True),
-        "access_control": access_control(keys, common_names),
-        "low_pass_filter": low_pass_filter(keys),
+        "access_control": access_control(keys, common_names, vss_keys),
+        "low_pass_filter": low_pass_filter(keys, vss_keys),
         "downsampling": downsampling(keys),
     }
 
@@ -142,12 +146,15 @@ def init_bundle(
     listen: str | None = None,
     path_root: Path | None = None,
     force: bool = False,
+    vss_keys: str = VSS_KEYS,
 ) -> dict[str, Path]:
     """Write the CA, each role's certificate and Zenoh file; returns {role: its zenoh.json5}.
 
     `endpoint` is where the other roles reach the router (its host goes into the router's
     certificate); `listen` is where the router listens (default: `endpoint`). Raises
     ConfigError before writing anything for a bad name, endpoint or a non-empty folder.
+    `vss_keys` is the key expression of the daemon's COVESA VSS signals (`Vehicle/**`, under
+    `zenoh.vss_prefix` when one is set): only the daemon may put there.
     """
     listen = listen or endpoint
     _check(out_dir, consumers, endpoint, listen, force)
@@ -180,7 +187,7 @@ def init_bundle(
         _write(folder / "ca.pem", ca.cert_pem)
         seen_as = (out_dir.resolve() if path_root is None else path_root) / role
         if server:
-            config = router_config(seen_as, listen, keys, names)
+            config = router_config(seen_as, listen, keys, names, vss_keys)
         elif role == "daemon":
             config = daemon_config(seen_as, endpoint)
         else:

@@ -8,7 +8,10 @@ feature broke; docs/security.md):
   yaw, final state, `alive`) and under `PREFIX/*/@adv/**` (the advanced publisher's cache,
   heartbeats and publisher token: `**` never matches an `@` chunk), and subscribe to the speed;
 - the speed provider may only put the speed;
-- consumers may only subscribe, query and watch liveliness under those keys of their vehicle.
+- consumers may only subscribe, query and watch liveliness under those keys of their vehicle;
+- the COVESA VSS signals (`--vss`, bare `Vehicle/**` paths unless `zenoh.vss_prefix` is set,
+  one vehicle per network as Eclipse Kuksa assumes): only the daemon may put them, consumers
+  (a Kuksa provider is one) may only subscribe to them.
 
 `ingress` is from a node into the router, `egress` from the router to a node. A peer only sends
 a put when it knows a matching subscriber, so the daemon must receive the consumers'
@@ -23,7 +26,7 @@ from roadgaze.transport.keys import Keys
 from roadgaze.transport.payloads import MESSAGE_MAX_BYTES, SPEED_MAX_BYTES
 
 Rule = tuple[str, list[str], list[str], list[str]]
-"""(rule id, message types, flows, key names among 'dms', 'adv', 'speed')."""
+"""(rule id, message types, flows, key names among 'dms', 'adv', 'speed', 'vss')."""
 
 PERMISSIONS: dict[str, list[Rule]] = {
     "daemon": [
@@ -32,6 +35,8 @@ PERMISSIONS: dict[str, list[Rule]] = {
         ("daemon-speed-sub", ["declare_subscriber"], ["ingress"], ["speed"]),
         ("daemon-speed-in", ["put"], ["egress"], ["speed"]),
         ("daemon-routes", ["declare_subscriber", "query"], ["egress"], ["dms", "adv"]),
+        ("daemon-vss", ["put"], ["ingress"], ["vss"]),
+        ("daemon-vss-routes", ["declare_subscriber"], ["egress"], ["vss"]),
     ],
     "speed": [("speed-out", ["put"], ["ingress"], ["speed"])],
     "consumer": [
@@ -39,20 +44,34 @@ PERMISSIONS: dict[str, list[Rule]] = {
          ["declare_subscriber", "query", "declare_liveliness_subscriber", "liveliness_query"],
          ["ingress"], ["dms", "adv"]),
         ("consumer-get", ["put", "reply", "liveliness_token"], ["egress"], ["dms", "adv"]),
+        ("consumer-vss-ask", ["declare_subscriber"], ["ingress"], ["vss"]),
+        ("consumer-vss-get", ["put"], ["egress"], ["vss"]),
     ],
 }  # fmt: skip
 STATE_QUERIES_PER_S = 20.0
 """Per client: a flooding client cannot crowd out the others' health checks."""
 SPEED_PUTS_PER_S = 100.0
+VSS_KEYS = "Vehicle/**"
+"""The VSS signals' key expression without `zenoh.vss_prefix`."""
+VSS_MAX_BYTES = 256
+"""A VSS value is a short text (`true`, `57.3`)."""
 
 
-def _key_exprs(keys: Keys, names: list[str]) -> list[str]:
-    table = {"dms": f"{keys.prefix}/**", "adv": keys.advanced, "speed": keys.speed or ""}
+def _key_exprs(keys: Keys, names: list[str], vss_keys: str) -> list[str]:
+    table = {
+        "dms": f"{keys.prefix}/**",
+        "adv": keys.advanced,
+        "speed": keys.speed or "",
+        "vss": vss_keys,
+    }
     return [table[name] for name in names if table[name]]
 
 
-def access_control(keys: Keys, common_names: dict[str, list[str]]) -> dict[str, Any]:
-    """The router's `access_control` section: default deny, one subject per role."""
+def access_control(
+    keys: Keys, common_names: dict[str, list[str]], vss_keys: str = VSS_KEYS
+) -> dict[str, Any]:
+    """The router's `access_control` section: default deny, one subject per role; `vss_keys`
+    is where the daemon's VSS signals go (`vss_key("Vehicle.**", zenoh.vss_prefix)`)."""
     rules: list[dict[str, Any]] = []
     subjects: list[dict[str, Any]] = []
     policies: list[dict[str, Any]] = []
@@ -63,7 +82,7 @@ def access_control(keys: Keys, common_names: dict[str, list[str]]) -> dict[str, 
         subjects.append({"id": f"{role}-subject", "cert_common_names": names})
         role_rules = []
         for rule_id, messages, flows, key_names in entries:
-            key_exprs = _key_exprs(keys, key_names)
+            key_exprs = _key_exprs(keys, key_names, vss_keys)
             if not key_exprs:
                 continue
             rules.append(
@@ -88,7 +107,7 @@ def access_control(keys: Keys, common_names: dict[str, list[str]]) -> dict[str, 
     }
 
 
-def low_pass_filter(keys: Keys) -> list[dict[str, Any]]:
+def low_pass_filter(keys: Keys, vss_keys: str = VSS_KEYS) -> list[dict[str, Any]]:
     """Router-side size limits (payload and attachment, bytes): larger messages are dropped
     whatever the transport (shared memory would bypass `rx/max_message_size`)."""
     filters = [
@@ -98,7 +117,14 @@ def low_pass_filter(keys: Keys) -> list[dict[str, Any]]:
             "flows": ["ingress"],
             "key_exprs": [f"{keys.prefix}/**"],
             "size_limit": MESSAGE_MAX_BYTES,
-        }
+        },
+        {
+            "id": "vss-size",
+            "messages": ["put"],
+            "flows": ["ingress"],
+            "key_exprs": [vss_keys],
+            "size_limit": VSS_MAX_BYTES,
+        },
     ]
     if keys.speed is not None:
         filters.insert(

@@ -2,6 +2,7 @@
 
 from roadgaze.synth.clip import (
     DEFAULT_FPS,
+    EYE_TRUTH_HEADER,
     TRUTH_HEADER,
     read_truth_csv,
     render_clip,
@@ -16,6 +17,14 @@ from roadgaze.synth.clip_measure import (
     format_clip_measurement,
     measure_clip,
 )
+from roadgaze.synth.eye_measure import (
+    EYE_DRIVE_TIMELINE,
+    EyeRecovery,
+    format_eye_measurement,
+    measure_eye_recovery,
+    write_eye_measurement_csv,
+)
+from roadgaze.synth.eyes import EyeRenderer, EyeState
 from roadgaze.synth.measure import (
     PITCH_ESTIMATORS,
     PITCH_RANGES_DEG,
@@ -52,6 +61,8 @@ __all__ = [
     "DEFAULT_FPS",
     "DEFAULT_SIZE",
     "DEFAULT_TRANSITION_S",
+    "EYE_DRIVE_TIMELINE",
+    "EYE_TRUTH_HEADER",
     "MAX_ABS_PITCH_DEG",
     "MAX_ABS_YAW_DEG",
     "MAX_CLIP_S",
@@ -62,6 +73,9 @@ __all__ = [
     "YAW_RANGES_DEG",
     "ChannelErrors",
     "ClipMeasurement",
+    "EyeRecovery",
+    "EyeRenderer",
+    "EyeState",
     "FaceRenderer",
     "Keyframe",
     "PhotoMesh",
@@ -70,10 +84,12 @@ __all__ = [
     "YawRecovery",
     "default_photo_path",
     "format_clip_measurement",
+    "format_eye_measurement",
     "format_measurement",
     "format_pitch_measurement",
     "load_photo",
     "measure_clip",
+    "measure_eye_recovery",
     "measure_pitch_recovery",
     "measure_yaw_recovery",
     "mesh_triangles",
@@ -83,6 +99,7 @@ __all__ = [
     "render_clip",
     "render_frames",
     "truth_path_for",
+    "write_eye_measurement_csv",
     "write_measurement_csv",
     "write_truth_csv",
     "zone_agreement",

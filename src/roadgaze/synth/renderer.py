@@ -231,7 +231,7 @@ class FaceRenderer:
         grow = max(3, round(0.06 * self.mesh.face_width_px))
         mask = cv2.dilate(mask, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * grow + 1,) * 2))
         known = (mask == 0).astype(np.float32)
-        filled = _push_pull_fill(self.texture.astype(np.float32), known)
+        filled = push_pull_fill(self.texture.astype(np.float32), known)
         background: ImageBGR = np.clip(filled + 0.5, 0, 255).astype(np.uint8)
         return background
 
@@ -239,25 +239,7 @@ class FaceRenderer:
         """The mesh nodded by pitch (about the head's lateral axis), then turned by yaw (about
         the vertical axis), both about the neck pivot: pitch is the elevation of the face's
         forward direction, as in Pointing'04's tilt and MediaPipe's matrix angles."""
-        yaw, pitch = math.radians(yaw_deg), math.radians(pitch_deg)
-        # Image axes: x right, y down, z away from the camera. Positive yaw moves the nose (z < 0
-        # relative to the pivot) to +x; positive pitch moves it up (-y).
-        rotate_yaw = np.array(
-            [
-                [math.cos(yaw), 0.0, -math.sin(yaw)],
-                [0.0, 1.0, 0.0],
-                [math.sin(yaw), 0.0, math.cos(yaw)],
-            ]
-        )
-        rotate_pitch = np.array(
-            [
-                [1.0, 0.0, 0.0],
-                [0.0, math.cos(pitch), math.sin(pitch)],
-                [0.0, -math.sin(pitch), math.cos(pitch)],
-            ]
-        )
-        relative = self.mesh.points_px - self.mesh.pivot_px
-        return np.asarray(relative @ (rotate_yaw @ rotate_pitch).T + self.mesh.pivot_px)
+        return turn_points(self.mesh.points_px, self.mesh.pivot_px, yaw_deg, pitch_deg)
 
     def render(self, yaw_deg: float, pitch_deg: float = 0.0) -> ImageBGR:
         """One BGR frame of the face turned to `yaw_deg`, `pitch_deg` over the background."""
@@ -299,7 +281,33 @@ class FaceRenderer:
         return frame
 
 
-def _push_pull_fill(
+def turn_points(
+    points_px: FloatArray, pivot_px: FloatArray, yaw_deg: float, pitch_deg: float = 0.0
+) -> FloatArray:
+    """(N, 3) points turned as the renderer turns the mesh, about `pivot_px`: nodded by pitch,
+    then turned by yaw (pitch is the elevation of the face's forward direction)."""
+    yaw, pitch = math.radians(yaw_deg), math.radians(pitch_deg)
+    # Image axes: x right, y down, z away from the camera. Positive yaw moves the nose (z < 0
+    # relative to the pivot) to +x; positive pitch moves it up (-y).
+    rotate_yaw = np.array(
+        [
+            [math.cos(yaw), 0.0, -math.sin(yaw)],
+            [0.0, 1.0, 0.0],
+            [math.sin(yaw), 0.0, math.cos(yaw)],
+        ]
+    )
+    rotate_pitch = np.array(
+        [
+            [1.0, 0.0, 0.0],
+            [0.0, math.cos(pitch), math.sin(pitch)],
+            [0.0, -math.sin(pitch), math.cos(pitch)],
+        ]
+    )
+    relative = np.asarray(points_px, dtype=np.float64) - pivot_px
+    return np.asarray(relative @ (rotate_yaw @ rotate_pitch).T + pivot_px)
+
+
+def push_pull_fill(
     image: npt.NDArray[np.float32], known: npt.NDArray[np.float32], depth: int = 0
 ) -> npt.NDArray[np.float32]:
     """Fill pixels where `known` is 0 from a coarser level of a pyramid (push-pull in-painting).
@@ -320,7 +328,7 @@ def _push_pull_fill(
     small_weight = cv2.pyrDown(known)
     has = small_weight > 1e-3
     small = np.where(has[..., None], small_sum / np.maximum(small_weight, 1e-3)[..., None], 0)
-    coarse = _push_pull_fill(small.astype(np.float32), has.astype(np.float32), depth + 1)
+    coarse = push_pull_fill(small.astype(np.float32), has.astype(np.float32), depth + 1)
     up = cv2.pyrUp(coarse, dstsize=(width, height))
     blended = known[..., None] * image + (1.0 - known[..., None]) * up
     return blended.astype(np.float32)

@@ -10,6 +10,7 @@ from roadgaze.transport.messages import (
     STATE_SCHEMA,
     YAW_SCHEMA,
     AlertMessage,
+    EyeFields,
     MonitorSnapshot,
     StateMessage,
     TransportStatus,
@@ -37,6 +38,15 @@ from roadgaze.transport.session import (
 )
 from roadgaze.transport.speed import SPEED_MAX_KMH, SpeedInput, parse_speed_kmh
 from roadgaze.transport.throttle import ThrottledWarning
+from roadgaze.transport.vss import (
+    VSS_PATHS,
+    VssLink,
+    VssPublisher,
+    parse_vss_text,
+    vss_key,
+    vss_text,
+    vss_values,
+)
 
 __all__ = [
     "ALERT_SCHEMA",
@@ -46,10 +56,12 @@ __all__ = [
     "SPEED_MAX_BYTES",
     "SPEED_MAX_KMH",
     "STATE_SCHEMA",
+    "VSS_PATHS",
     "YAW_SCHEMA",
     "AlertCounts",
     "AlertMessage",
     "BusPublisher",
+    "EyeFields",
     "Health",
     "Keys",
     "LinkState",
@@ -63,6 +75,8 @@ __all__ = [
     "StateMessage",
     "ThrottledWarning",
     "TransportStatus",
+    "VssLink",
+    "VssPublisher",
     "YawMessage",
     "ZenohLink",
     "build_zenoh_config",
@@ -73,8 +87,12 @@ __all__ = [
     "parse_json_object",
     "parse_json_value",
     "parse_speed_kmh",
+    "parse_vss_text",
     "plan_session",
     "printable",
     "router_config",
+    "vss_key",
+    "vss_text",
+    "vss_values",
     "zenoh_error_text",
 ]

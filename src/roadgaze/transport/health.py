@@ -19,6 +19,7 @@ from roadgaze.monitor import initial_state, verdict_of
 from roadgaze.transport.keys import Keys
 from roadgaze.transport.messages import (
     AlertMessage,
+    EyeFields,
     MonitorSnapshot,
     StateMessage,
     TransportStatus,
@@ -73,12 +74,13 @@ class Health:
             self.alerts_raised += 1
             self.recent_alerts.append(alert)
             log.info(
-                "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)",
+                "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)%s",
                 alert.kind.value,
                 alert.level.value,
                 alert.t_s,
                 alert.off_road_s,
                 alert.window_off_road_s,
+                f": {alert.reason}" if alert.reason else "",
                 extra={"alert": message.model_dump(mode="json", by_alias=True)},
             )
 
@@ -110,11 +112,17 @@ class Health:
                 problems.append(current.message or "camera lost; reconnecting")
         if self.link is not None and not transport.connected:
             problems.append("zenoh not connected")
+        verdict = self._initial_verdict if record is None else record.verdict
+        eyes = verdict.eyes
+        if eyes.degraded:
+            problems.append(
+                f"eyes unavailable for {eyes.unavailable_s:.0f} s ({eyes.reason or 'unknown'}): "
+                "monitoring on head pose only"
+            )
         status = self.status
         if status in ("starting", "running") and problems:
             status = "degraded"
         monitor = self.config.monitor
-        verdict = self._initial_verdict if record is None else record.verdict
         return StateMessage(
             vehicle_id=self.keys.vehicle_id,
             wall_time=self._wall_clock(),
@@ -129,6 +137,7 @@ class Health:
             camera_reopens=camera_reopens,
             transport=transport,
             monitor=MonitorSnapshot(
+                **EyeFields.of(eyes),
                 gaze=verdict.gaze,
                 on_road=verdict.on_road is not False,
                 neutral_yaw_deg=verdict.neutral_yaw_deg,

@@ -12,6 +12,8 @@ Under the prefix (default `vehicle/{vehicle_id}/dms`):
 - `yaw`: one `YawMessage` per frame, congestion control DROP, priority DATA (droppable).
 - `alive`: a liveliness token, present while the daemon runs.
 - `state`: a queryable answering a `StateMessage` from a bounded thread (`StateResponder`).
+- with `vss_keys`, one text publisher per COVESA VSS signal (`roadgaze.transport.vss`):
+  congestion control BLOCK, priority DATA; no cache (every value is sent again each second).
 
 The link state comes from Zenoh's transport events (`LinkState`): an alert published while no
 transport is open is counted as held, never as sent. The speed subscriber keeps only the newest
@@ -41,6 +43,7 @@ from roadgaze.transport.session import (
     zenoh_error_text,
 )
 from roadgaze.transport.speed import SpeedInput
+from roadgaze.transport.vss import VSS_ATTACHMENT
 
 log = logging.getLogger(__name__)
 
@@ -79,6 +82,15 @@ class _Declared:
                 publisher_detection=True,
             )
             self._entities.append(self.alert)
+            self.vss: dict[str, Any] = {}
+            for key in link.vss_keys:
+                self.vss[key] = session.declare_publisher(
+                    key,
+                    encoding=zenoh.Encoding.TEXT_PLAIN,
+                    congestion_control=zenoh.CongestionControl.BLOCK,
+                    priority=zenoh.Priority.DATA,
+                )
+                self._entities.append(self.vss[key])
             self.yaw = session.declare_publisher(
                 keys.yaw,
                 encoding=zenoh.Encoding.APPLICATION_JSON,
@@ -137,9 +149,11 @@ class ZenohLink:
         state_reply: Callable[[], bytes] | None = None,
         speed: SpeedInput | None = None,
         plan: SessionPlan | None = None,
+        vss_keys: tuple[str, ...] = (),
     ) -> None:
         self.config = config
         self.keys = keys
+        self.vss_keys = vss_keys
         self.state_reply = state_reply
         self.speed = speed
         self._zconf, self.plan = build_zenoh_config(plan or plan_session(config, "daemon"))
@@ -153,6 +167,8 @@ class ZenohLink:
         self.session_reopens = 0
         self.yaw_sent = 0
         self.yaw_not_sent = 0
+        self.vss_sent = 0
+        self.vss_not_sent = 0
         self.last_error: str | None = None
 
     def __enter__(self) -> ZenohLink:
@@ -238,6 +254,21 @@ class ZenohLink:
             self.yaw_not_sent += 1
             self.last_error = f"yaw put failed: {exc}"
 
+    def publish_vss(self, key: str, payload: bytes) -> None:
+        """One VSS value (text) on its key, with Kuksa's `currentValue` attachment; counted as
+        not sent without a session (the next change is sent again)."""
+        declared = self._declared
+        publisher = None if declared is None else declared.vss.get(key)
+        if publisher is None:
+            self.vss_not_sent += 1
+            return
+        try:
+            publisher.put(payload, attachment=VSS_ATTACHMENT)
+            self.vss_sent += 1
+        except Exception as exc:
+            self.vss_not_sent += 1
+            self.last_error = f"vss put failed: {exc}"
+
     def publish_alert(self, message: AlertMessage) -> None:
         """Publish (or, before a client session opens, hold) one alert; never raises."""
         payload = message.to_json_bytes()
@@ -282,8 +313,9 @@ class ZenohLink:
             routers=routers,
             session_reopens=self.session_reopens,
             yaw_sent=self.yaw_sent,
+            vss_sent=self.vss_sent,
             alerts_sent=counts.sent,
-            not_sent=self.yaw_not_sent + counts.failed + self._pending_dropped,
+            not_sent=self.yaw_not_sent + self.vss_not_sent + counts.failed + self._pending_dropped,
             pending_alerts=pending,
             speed_messages=speed.messages if speed is not None else 0,
             speed_rejected=speed.rejected if speed is not None else 0,

@@ -12,10 +12,18 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from roadgaze.types import Alert, AlertKind, AlertLevel, FrameRecord, Gaze
+from roadgaze.types import (
+    Alert,
+    AlertKind,
+    AlertLevel,
+    EyeStatus,
+    EyesVerdict,
+    FrameRecord,
+    Gaze,
+)
 
-YAW_SCHEMA = "roadgaze.yaw/2"
-ALERT_SCHEMA = "roadgaze.alert/1"
+YAW_SCHEMA = "roadgaze.yaw/3"
+ALERT_SCHEMA = "roadgaze.alert/2"
 STATE_SCHEMA = "roadgaze.state/3"
 
 
@@ -32,14 +40,62 @@ class _Message(BaseModel):
         return self.model_dump_json(by_alias=True).encode("utf-8")
 
 
-class YawMessage(_Message):
-    """One frame's head pose (yaw, pitch, roll), glance zone and road-ahead decision.
+class EyeFields(_Message):
+    """The eyes as the monitor judged them (docs/monitor.md); in the yaw and state messages."""
 
-    `roadgaze.yaw/2` extends `/1` with `pitch_deg`, `pitch_raw_deg`, `roll_deg`, `zone`,
-    `eyes_on_road` and `neutral_pitch_deg`; every `/1` field keeps its name and meaning.
+    eyes: EyeStatus = Field(
+        default=EyeStatus.UNAVAILABLE, description="open, closed or unavailable"
+    )
+    eyes_reason: str = Field(
+        default="", description="Why unavailable, or 'looking down' for narrowed lids."
+    )
+    eye_openness: float | None = Field(
+        default=None, description="Lid gap / eye width (about 0.3 open, 0.1 closed)."
+    )
+    gaze_yaw_deg: float | None = Field(
+        default=None, description="Head yaw + eye yaw beyond the deadband; > 0 = driver's left."
+    )
+    gaze_pitch_deg: float | None = Field(default=None, description="> 0 = up.")
+    gaze_source: Literal["eyes", "head", "none"] = "none"
+    closure_s: float = Field(default=0.0, ge=0, description="Current closure length.")
+    perclos: float | None = Field(
+        default=None, ge=0, le=1, description="Closed share of the last 60 s (judged time)."
+    )
+    blinks: int = Field(default=0, ge=0, description="Blinks in the PERCLOS window.")
+    eyes_unavailable_s: float = Field(default=0.0, ge=0)
+    degraded: bool = Field(
+        default=False, description="Eyes unavailable too long: head pose only (impaired)."
+    )
+
+    @staticmethod
+    def of(eyes: EyesVerdict) -> dict[str, Any]:
+        """The fields' values from the monitor's verdict."""
+        return {
+            "eyes": eyes.status,
+            "eyes_reason": eyes.reason,
+            "eye_openness": eyes.openness,
+            "gaze_yaw_deg": eyes.gaze_yaw_deg,
+            "gaze_pitch_deg": eyes.gaze_pitch_deg,
+            "gaze_source": eyes.gaze_source,
+            "closure_s": max(0.0, eyes.closure_s),
+            "perclos": eyes.perclos,
+            "blinks": eyes.blinks,
+            "eyes_unavailable_s": max(0.0, eyes.unavailable_s),
+            "degraded": eyes.degraded,
+        }
+
+
+class YawMessage(EyeFields):
+    """One frame's head pose (yaw, pitch, roll), glance zone, eyes and road-ahead decision.
+
+    `roadgaze.yaw/2` extended `/1` with `pitch_deg`, `pitch_raw_deg`, `roll_deg`, `zone`,
+    `eyes_on_road` and `neutral_pitch_deg`; `roadgaze.yaw/3` adds the eye fields (`eyes`,
+    `eye_openness`, `gaze_*`, `closure_s`, `perclos`, `blinks`, `eyes_unavailable_s`,
+    `degraded`), and `eyes_on_road` is false while the eyes are closed. Every earlier field keeps
+    its name and meaning.
     """
 
-    schema_id: Literal["roadgaze.yaw/2"] = Field(default="roadgaze.yaw/2", alias="schema")
+    schema_id: Literal["roadgaze.yaw/3"] = Field(default="roadgaze.yaw/3", alias="schema")
     vehicle_id: str
     seq: int = Field(ge=0, description="Per-key sequence number, from 0 at start.")
     t_s: float = Field(
@@ -69,7 +125,8 @@ class YawMessage(_Message):
         "(or another configured zone) or away; null when the gaze is unknown.",
     )
     eyes_on_road: bool | None = Field(
-        default=None, description="zone == 'road'; null when the gaze is unknown."
+        default=None,
+        description="zone == 'road' and the eyes not closed; null when the gaze is unknown.",
     )
     neutral_pitch_deg: float = 0.0
 
@@ -97,15 +154,20 @@ class YawMessage(_Message):
             pitch_raw_deg=sample.pitch_raw_deg,
             roll_deg=sample.roll_deg,
             zone=verdict.zone,
-            eyes_on_road=verdict.on_road,
+            eyes_on_road=verdict.eyes_on_road,
             neutral_pitch_deg=verdict.neutral_pitch_deg,
+            **EyeFields.of(verdict.eyes),
         )
 
 
 class AlertMessage(_Message):
-    """One monitor event (see docs/monitor.md)."""
+    """One monitor event (see docs/monitor.md).
 
-    schema_id: Literal["roadgaze.alert/1"] = Field(default="roadgaze.alert/1", alias="schema")
+    `roadgaze.alert/2` adds the kinds `microsleep`, `sleep`, `drowsy`, `unresponsive` and
+    `degraded`, and the fields `closure_s`, `perclos` and `reason`.
+    """
+
+    schema_id: Literal["roadgaze.alert/2"] = Field(default="roadgaze.alert/2", alias="schema")
     vehicle_id: str
     seq: int = Field(ge=0)
     kind: AlertKind
@@ -120,6 +182,9 @@ class AlertMessage(_Message):
     clears: list[AlertKind] = Field(
         default_factory=list, description="For 'cleared': the alerts it ends."
     )
+    closure_s: float = Field(default=0.0, ge=0, description="Current eye closure length.")
+    perclos: float | None = Field(default=None, ge=0, le=1)
+    reason: str = Field(default="", description="Why it fired, in a few words.")
 
     @classmethod
     def from_alert(cls, alert: Alert, vehicle_id: str, seq: int, wall_time: float) -> AlertMessage:
@@ -137,6 +202,9 @@ class AlertMessage(_Message):
             unavailable_s=max(0.0, alert.unavailable_s),
             speed_kmh=alert.speed_kmh,
             clears=[kind for kind in alert.clears if kind is not AlertKind.CLEARED],
+            closure_s=max(0.0, alert.closure_s),
+            perclos=alert.perclos,
+            reason=alert.reason,
         )
 
 
@@ -152,8 +220,11 @@ class TransportStatus(_Message):
     routers: int = 0
     session_reopens: int = 0
     yaw_sent: int = 0
+    vss_sent: int = Field(default=0, description="COVESA VSS values published.")
     alerts_sent: int = Field(default=0, description="Alerts published while the link was up.")
-    not_sent: int = Field(default=0, description="yaw_not_sent + alerts_failed.")
+    not_sent: int = Field(
+        default=0, description="yaw_not_sent + VSS values not sent + alerts_failed."
+    )
     pending_alerts: int = Field(
         default=0, description="Client mode: alerts held by roadgaze until the session opens."
     )
@@ -181,7 +252,7 @@ class TransportStatus(_Message):
     state_queries_answered: int = 0
 
 
-class MonitorSnapshot(_Message):
+class MonitorSnapshot(EyeFields):
     gaze: Gaze
     on_road: bool
     neutral_yaw_deg: float
@@ -203,9 +274,11 @@ class MonitorSnapshot(_Message):
 class StateMessage(_Message):
     """Answer of the `state` queryable: health, monitor state, counters and config summary.
 
-    `roadgaze.state/2` adds `zone`, `pitch_deg` and `neutral_pitch_deg` to `monitor`;
-    `roadgaze.state/3` adds link and delivery fields to `transport` (see `TransportStatus`) and
-    the speed source `invalid`. Every earlier field keeps its name and meaning.
+    `roadgaze.state/2` added `zone`, `pitch_deg` and `neutral_pitch_deg` to `monitor`;
+    `roadgaze.state/3` adds link and delivery fields to `transport` (see `TransportStatus`, and
+    `vss_sent`), the speed source `invalid`, the eye fields of the yaw message to `monitor`, and
+    the status `degraded` (with a problem saying why) while the eyes have been unavailable too
+    long. Every earlier field keeps its name and meaning.
     """
 
     schema_id: Literal["roadgaze.state/3"] = Field(default="roadgaze.state/3", alias="schema")

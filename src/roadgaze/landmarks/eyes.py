@@ -1,0 +1,382 @@
+"""The driver's eyes from MediaPipe's 478 landmarks and blendshapes (pure numpy).
+
+`eye_features(...)` measures, per eye, the lid aperture (openness), the eye-in-head direction and
+whether the eye can be used, and returns an `EyesFeatures`. Definitions (measured choices and
+their evidence: docs/eyes.md):
+
+- **Sides.** MediaPipe's iris 468-472 and `eyeBlinkRight` belong to the person's right eye (on
+  the image's left for an unmirrored camera); 473-477 and `*Left` to the left eye.
+- **Openness** = mean vertical gap of three upper/lower lid landmark pairs, roll removed, divided
+  by W, the width (outer to inner corner) of the wider eye in the image. Dividing by the wider
+  eye keeps the far eye of a turned head from reading wide open. About 0.3 open, 0.1 closed
+  (MediaPipe's lids never quite meet).
+- **Direction** (default): the eyeLook* blendshapes scaled to degrees by a synthetic
+  calibration, yaw = (eyeLookOut - eyeLookIn) / 0.0229 (sign by side), pitch = (eyeLookUp -
+  eyeLookDown) / 0.0148. The iris model (an eyeball of radius k W rotating about a centre behind
+  the corner midpoint, orthographic camera) is computed beside it as a diagnostic.
+- **Usable eyes.** No eye without a head yaw, beyond `max_head_yaw_deg`, below
+  `min_eye_width_px`, at landmark quality under `min_quality`, or when the image check finds the
+  eyes hidden (sunglasses). Beyond `far_eye_max_yaw_deg`, or narrower than
+  `far_eye_min_width_ratio` of the other, the far eye is dropped. The nearer eye's openness is
+  still judged up to `closure_max_head_yaw_deg`.
+
+Sign convention: image x right, y down; yaw > 0 toward the person's own left (the iris moves to
+the image right), pitch > 0 up.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from roadgaze.config import EyesConfig
+from roadgaze.landmarks.features import NUM_LANDMARKS, remove_roll, roll_from_eyes_deg
+from roadgaze.types import EyeMeasurement, EyesFeatures, FaceFeatures, FloatArray
+
+
+@dataclass(frozen=True, slots=True)
+class EyeIndices:
+    """MediaPipe landmark indices and blendshape names of one eye (the person's own side)."""
+
+    side: str
+    outer: int
+    inner: int
+    lid_pairs: tuple[tuple[int, int], ...]
+    """(upper, lower) lid landmarks, the centre pair first."""
+    iris_center: int
+    iris_ring: tuple[int, int, int, int]
+    """Iris contour: image right, top, image left, bottom."""
+    contour: tuple[int, ...]
+    """The eye opening as a closed loop: outer corner, upper lid, inner corner, lower lid."""
+    lateral: float
+    """+1 when the eye's outer corner lies toward the image right (the person's left eye)."""
+    blink: str
+    look_in: str
+    look_out: str
+    look_up: str
+    look_down: str
+
+
+RIGHT_EYE = EyeIndices(
+    side="right",
+    outer=33,
+    inner=133,
+    lid_pairs=((159, 145), (158, 153), (160, 144)),
+    iris_center=468,
+    iris_ring=(469, 470, 471, 472),
+    contour=(33, 246, 161, 160, 159, 158, 157, 173, 133, 155, 154, 153, 145, 144, 163, 7),
+    lateral=-1.0,
+    blink="eyeBlinkRight",
+    look_in="eyeLookInRight",
+    look_out="eyeLookOutRight",
+    look_up="eyeLookUpRight",
+    look_down="eyeLookDownRight",
+)
+LEFT_EYE = EyeIndices(
+    side="left",
+    outer=263,
+    inner=362,
+    lid_pairs=((386, 374), (385, 380), (387, 373)),
+    iris_center=473,
+    iris_ring=(474, 475, 476, 477),
+    contour=(263, 466, 388, 387, 386, 385, 384, 398, 362, 382, 381, 380, 374, 373, 390, 249),
+    lateral=1.0,
+    blink="eyeBlinkLeft",
+    look_in="eyeLookInLeft",
+    look_out="eyeLookOutLeft",
+    look_up="eyeLookUpLeft",
+    look_down="eyeLookDownLeft",
+)
+EYES = (RIGHT_EYE, LEFT_EYE)
+
+BLENDSHAPE_YAW_PER_DEG = 0.0229
+"""eyeLookOut - eyeLookIn per degree of eye-in-head yaw: the slope on rendered eyes turned
+-30..30 deg with the head frontal (`roadgaze synth --measure --eyes`, docs/eyes.md)."""
+BLENDSHAPE_PITCH_PER_DEG = 0.0148
+"""eyeLookUp - eyeLookDown per degree of eye pitch (same renders, eye pitch -20..20 deg)."""
+
+
+@dataclass(frozen=True, slots=True)
+class EyeballConstants:
+    """The iris model's constants in units of the frontal eye width W.
+
+    `k`: the iris centre lies k W in front of the eye's rotation centre (the pupil plane is about
+    10.5 mm in front of it, W about 27 mm). `lam`, `mu`: the iris at rest lies lam W lateral of
+    and mu W above the corner midpoint (measured on Pointing'04's frontal stills). `b`: the iris
+    at rest lies b W in front of the corner midpoint.
+    """
+
+    k: float = 0.40
+    lam: float = 0.047
+    mu: float = 0.078
+    b: float = 0.20
+
+
+EYEBALL = EyeballConstants()
+
+
+def head_rotation(yaw_deg: float, pitch_deg: float) -> FloatArray:
+    """Head frame -> camera frame (x right, y down, z toward the camera): yaw, then pitch.
+
+    Yaw > 0 moves a point in front of the face (z > 0) to +x; pitch > 0 moves it up (-y).
+    """
+    yaw, pitch = math.radians(yaw_deg), math.radians(pitch_deg)
+    rotate_yaw = np.array(
+        [
+            [math.cos(yaw), 0.0, math.sin(yaw)],
+            [0.0, 1.0, 0.0],
+            [-math.sin(yaw), 0.0, math.cos(yaw)],
+        ]
+    )
+    rotate_pitch = np.array(
+        [
+            [1.0, 0.0, 0.0],
+            [0.0, math.cos(pitch), -math.sin(pitch)],
+            [0.0, math.sin(pitch), math.cos(pitch)],
+        ]
+    )
+    return np.asarray(rotate_pitch @ rotate_yaw, dtype=np.float64)
+
+
+def direction_deg(vector: FloatArray) -> tuple[float, float]:
+    """Yaw and pitch (degrees) of a direction given as (x right, y down, z toward the camera)."""
+    x, y, z = (float(v) for v in vector)
+    return math.degrees(math.atan2(x, z)), math.degrees(math.atan2(-y, math.hypot(x, z)))
+
+
+def iris_direction_deg(
+    upright_px: FloatArray,
+    eye: EyeIndices,
+    scale_px: float,
+    head_yaw_deg: float,
+    head_pitch_deg: float,
+    constants: EyeballConstants = EYEBALL,
+) -> tuple[float, float]:
+    """Eye-in-head yaw and pitch (degrees) of one eye by the iris (eyeball-centre) model.
+
+    The rotation centre E lies at `(lateral lam, -mu, b - k) W` from the corner midpoint in the
+    head frame; it is projected with the head rotation, and the iris centre's offset from it
+    divided by k W is the x, y of the unit gaze vector in the camera frame. Rotated back by the
+    head it gives the eye-in-head direction; for pitch 0, sin(yaw_head + yaw_eye) = dx / (k W).
+    """
+    rotation = head_rotation(head_yaw_deg, head_pitch_deg)
+    middle = 0.5 * (upright_px[eye.outer] + upright_px[eye.inner])
+    centre_in_head = np.array(
+        [eye.lateral * constants.lam, -constants.mu, constants.b - constants.k]
+    ) * (scale_px)
+    centre_px = middle + (rotation @ centre_in_head)[:2]
+    dx, dy = (upright_px[eye.iris_center] - centre_px) / (constants.k * scale_px)
+    planar = math.hypot(dx, dy)
+    if planar > 1.0:  # further out than an eyeball allows: saturate at the limb
+        dx, dy, planar = dx / planar, dy / planar, 1.0
+    gaze_camera = np.array([dx, dy, math.sqrt(max(0.0, 1.0 - planar * planar))])
+    return direction_deg(rotation.T @ gaze_camera)
+
+
+def blendshape_direction_deg(
+    blendshapes: Mapping[str, float], eye: EyeIndices
+) -> tuple[float, float] | None:
+    """Eye-in-head yaw and pitch (degrees) of one eye from the eyeLook* blendshapes.
+
+    For the left eye, looking out turns it to the person's left (yaw > 0); for the right eye,
+    looking in does. None when a score is missing.
+    """
+    try:
+        out_minus_in = blendshapes[eye.look_out] - blendshapes[eye.look_in]
+        up_minus_down = blendshapes[eye.look_up] - blendshapes[eye.look_down]
+    except KeyError:
+        return None
+    toward_left = out_minus_in if eye.side == "left" else -out_minus_in
+    return toward_left / BLENDSHAPE_YAW_PER_DEG, up_minus_down / BLENDSHAPE_PITCH_PER_DEG
+
+
+def lid_openness(upright_px: FloatArray, eye: EyeIndices, scale_px: float) -> float:
+    """Mean vertical lid gap of the eye's lid pairs / `scale_px` (negative when lids cross)."""
+    gaps = [upright_px[lower, 1] - upright_px[upper, 1] for upper, lower in eye.lid_pairs]
+    return float(np.mean(gaps)) / scale_px
+
+
+def _face_reason(
+    head_yaw_deg: float | None,
+    scale_px: float,
+    quality: float,
+    occluded: bool,
+    max_yaw_deg: float,
+    config: EyesConfig,
+) -> str:
+    if head_yaw_deg is None:
+        return "no head yaw"
+    if abs(head_yaw_deg) > max_yaw_deg:
+        return "head turned"
+    if scale_px < config.min_eye_width_px:
+        return "eyes too small"
+    if quality < config.min_quality:
+        return "low landmark quality"
+    if occluded:
+        return "eyes hidden"
+    return ""
+
+
+def eye_features(
+    landmarks_px: npt.ArrayLike,
+    head_yaw_deg: float | None,
+    head_pitch_deg: float | None = None,
+    blendshapes: Mapping[str, float] | None = None,
+    quality: float = 1.0,
+    contrast: tuple[float, float] | None = None,
+    config: EyesConfig | None = None,
+) -> EyesFeatures:
+    """Openness, direction and usability of both eyes of one face.
+
+    `landmarks_px`: MediaPipe's (478, 2|3) landmarks in pixels. `head_yaw_deg`: the service's head
+    yaw (None when unknown: no eye gives a direction). `head_pitch_deg`: MediaPipe's matrix pitch
+    (0 when None), used by the iris model only. `blendshapes`: the 52 scores by name (None: the
+    direction falls back to the iris model, and there is no blink score). `contrast`: (right,
+    left) from `eye_contrast`. Raises ValueError for a wrong shape or non-finite landmarks.
+    """
+    config = config if config is not None else EyesConfig()
+    points = np.asarray(landmarks_px, dtype=np.float64)
+    if points.ndim != 2 or points.shape[0] != NUM_LANDMARKS or points.shape[1] not in (2, 3):
+        raise ValueError(f"expected ({NUM_LANDMARKS}, 2|3) landmarks, found shape {points.shape}")
+    if not np.all(np.isfinite(points[:, :2])):
+        raise ValueError("landmarks contain NaN or infinite values")
+    upright = remove_roll(points, roll_from_eyes_deg(points))
+    widths = {e.side: float(np.linalg.norm(upright[e.outer] - upright[e.inner])) for e in EYES}
+    scale = max(widths.values())
+    yaw = None if head_yaw_deg is None or not math.isfinite(head_yaw_deg) else head_yaw_deg
+    pitch = 0.0 if head_pitch_deg is None or not math.isfinite(head_pitch_deg) else head_pitch_deg
+    use_blendshapes = config.method == "blendshapes" and blendshapes is not None
+    openness = {e.side: lid_openness(upright, e, scale) for e in EYES}
+    contrasts = (
+        {"right": None, "left": None}
+        if contrast is None
+        else dict(zip(("right", "left"), contrast, strict=True))
+    )
+    occluded = _occluded(openness, contrasts, config)
+    gaze_face = _face_reason(yaw, scale, quality, occluded, config.max_head_yaw_deg, config)
+    closure_face = _face_reason(
+        0.0 if yaw is None else yaw,
+        scale,
+        quality,
+        occluded,
+        config.closure_max_head_yaw_deg,
+        config,
+    )
+    # The nearer eye: toward the camera when the head turns (yaw > 0 shows the right eye more),
+    # else the wider one in the image.
+    if yaw is not None and abs(yaw) > config.far_eye_max_yaw_deg:
+        near = "right" if yaw > 0 else "left"
+    else:
+        near = max(widths, key=lambda side: widths[side])
+    measured = []
+    for eye in EYES:
+        far_reason = ""
+        if eye.side != near:
+            if yaw is not None and abs(yaw) > config.far_eye_max_yaw_deg:
+                far_reason = "far eye"
+            elif widths[eye.side] < config.far_eye_min_width_ratio * scale:
+                far_reason = "far eye narrow"
+        gaze_reason = gaze_face or far_reason
+        closure_reason = closure_face or far_reason
+        yaw_deg = pitch_deg = iris_yaw = iris_pitch = None
+        if not gaze_reason and yaw is not None:
+            iris_yaw, iris_pitch = iris_direction_deg(upright, eye, scale, yaw, pitch)
+            direction = (
+                blendshape_direction_deg(blendshapes, eye)
+                if use_blendshapes and blendshapes is not None
+                else (iris_yaw, iris_pitch)
+            )
+            if direction is not None:
+                yaw_deg, pitch_deg = direction
+        measured.append(
+            EyeMeasurement(
+                side=eye.side,
+                width_px=widths[eye.side],
+                openness=openness[eye.side],
+                gaze_usable=yaw_deg is not None,
+                closure_usable=not closure_reason,
+                reason=gaze_reason or closure_reason,
+                yaw_deg=yaw_deg,
+                pitch_deg=pitch_deg,
+                blink=_score(blendshapes, eye.blink),
+                look_down=_look_down(blendshapes, eye),
+                iris_yaw_deg=iris_yaw,
+                iris_pitch_deg=iris_pitch,
+                contrast=contrasts[eye.side],
+            )
+        )
+    right, left = measured
+    reason = "" if right.gaze_usable or left.gaze_usable else (gaze_face or "no eye")
+    return EyesFeatures(
+        right=right,
+        left=left,
+        method="blendshapes" if use_blendshapes else "iris",
+        scale_px=scale,
+        reason=reason,
+        occluded=occluded,
+    )
+
+
+def driver_eyes(
+    face: FaceFeatures | None, head_yaw_deg: float | None, config: EyesConfig | None = None
+) -> EyesFeatures | None:
+    """`eye_features` of one detected face; None without a face or without MediaPipe's 478
+    landmarks (a test's fake detector)."""
+    if face is None or face.landmarks_px.shape[0] != NUM_LANDMARKS:
+        return None
+    try:
+        return eye_features(
+            face.landmarks_px,
+            head_yaw_deg,
+            face.mediapipe_pitch_deg,
+            face.blendshapes,
+            face.quality,
+            face.eye_contrast,
+            config,
+        )
+    except ValueError:
+        return None
+
+
+def _score(blendshapes: Mapping[str, float] | None, name: str) -> float | None:
+    if blendshapes is None or name not in blendshapes:
+        return None
+    return float(blendshapes[name])
+
+
+def _look_down(blendshapes: Mapping[str, float] | None, eye: EyeIndices) -> float | None:
+    down, up = _score(blendshapes, eye.look_down), _score(blendshapes, eye.look_up)
+    return None if down is None or up is None else down - up
+
+
+def _occluded(
+    openness: Mapping[str, float], contrasts: Mapping[str, float | None], config: EyesConfig
+) -> bool:
+    """Both measured eyes show a flat opening although the lids look open (a dark lens)."""
+    if config.min_contrast <= 0:
+        return False
+    measured = [
+        (openness[side], value)
+        for side, value in contrasts.items()
+        if value is not None and math.isfinite(value)
+    ]
+    return bool(measured) and all(
+        value < config.min_contrast and open_value >= config.occluded_min_openness
+        for open_value, value in measured
+    )
+
+
+def swap_sides(blendshapes: Mapping[str, float]) -> dict[str, float]:
+    """Blendshape scores with every Left and Right name swapped (for a mirrored image)."""
+    swapped: dict[str, float] = {}
+    for name, score in blendshapes.items():
+        if name.endswith("Left"):
+            name = name[: -len("Left")] + "Right"
+        elif name.endswith("Right"):
+            name = name[: -len("Right")] + "Left"
+        swapped[name] = score
+    return swapped

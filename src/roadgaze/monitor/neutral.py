@@ -1,0 +1,58 @@
+"""The neutral (road-ahead) head pose, learned from samples that look roughly ahead. Pure."""
+
+from __future__ import annotations
+
+import math
+
+from roadgaze.config import MonitorConfig
+from roadgaze.monitor.state import MonitorState
+
+__all__ = ["learn_neutral"]
+
+_MAX_LEARNING_STEP_S = 1.0
+"""A longer gap between samples teaches the neutral pose no more than one second would."""
+
+
+def _learn(value: float, neutral: float, gain: float, limit: float) -> float:
+    return max(-limit, min(limit, neutral + gain * (value - neutral)))
+
+
+def learn_neutral(
+    config: MonitorConfig,
+    state: MonitorState,
+    yaw_deg: float | None,
+    pitch_deg: float | None,
+    t_s: float,
+) -> tuple[float, float, float, float]:
+    """The neutral yaw and pitch after this sample and the time each has learned from.
+
+    A sample teaches when the head looks ahead: its yaw within the road's entry bound
+    (`road_half_width_deg - hysteresis_deg`) of the neutral yaw, and its pitch within
+    +-`neutral_pitch_limit_deg` (where a neutral pitch may lie). The pitch test is wider than the
+    road zone, so a camera above or below the line of sight, whose road pose reads outside the
+    road zone at first, is still learned. The yaw test is not: a sample in the hysteresis band
+    may be a glance held just past the road's edge, and learning from it would walk the neutral
+    after the glance until the glance reads as road (fail-safe: an alert is never learned
+    away). The gain is the larger of
+    the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
+    over the time learned so far): the neutral settles on the driver's road pose within seconds
+    of the start and then follows it slowly.
+    """
+    yaw, pitch = state.neutral_yaw_deg, state.neutral_pitch_deg
+    yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s
+    if yaw_deg is None or state.t_s is None:
+        return yaw, pitch, yaw_s, pitch_s
+    ahead = abs(yaw_deg - yaw) <= config.road_half_width_deg - config.hysteresis_deg
+    level = pitch_deg is None or abs(pitch_deg) <= config.neutral_pitch_limit_deg
+    if not (ahead and level):
+        return yaw, pitch, yaw_s, pitch_s
+    dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
+    slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)
+    if config.neutral_yaw_deg is None:
+        gain = max(slow_gain, dt_s / (yaw_s + dt_s))
+        yaw, yaw_s = _learn(yaw_deg, yaw, gain, config.neutral_limit_deg), yaw_s + dt_s
+    if config.neutral_pitch_deg is None and pitch_deg is not None:
+        gain = max(slow_gain, dt_s / (pitch_s + dt_s))
+        pitch = _learn(pitch_deg, pitch, gain, config.neutral_pitch_limit_deg)
+        pitch_s += dt_s
+    return yaw, pitch, yaw_s, pitch_s

@@ -106,6 +106,45 @@ def test_eye_movements_that_keep_the_gaze_on_the_road(eye_yaw: float, eye_pitch:
 
 
 @pytest.mark.parametrize(
+    ("head_yaw", "eye_yaw", "zone"),
+    [
+        (-40.0, 35.0, "right_mirror"),  # eyes read turned back: a gaze of -15 would be road
+        (27.0, -27.0, "left_mirror"),  # the demo's mirror glance as MediaPipe read it: gaze 10
+    ],
+)
+def test_the_eyes_never_bring_a_head_that_is_off_the_road_back_onto_it(
+    head_yaw: float, eye_yaw: float, zone: str
+) -> None:
+    """Fail-safe: the eyes may take the gaze off the road, never back onto it. On the demo's
+    rendered drive MediaPipe read the eyes turned back by up to 27 deg during head turns of
+    27-39 deg; judged on that gaze, a mirror glance and part of a look away were on the road
+    and the demo's VATS alert was lost. The first frame of the turn is checked (the eyes'
+    neutral, learned on the road, has not moved yet)."""
+    probe = Monitor(FIXED)
+    for frame in range(round(2.0 * FPS)):
+        probe.update(_sample(frame / FPS, eyes_of()), None)
+    t_s = 2.0
+    probe.update(
+        PoseSample(
+            t_s,
+            30,
+            True,
+            head_yaw,
+            head_yaw,
+            0.0,
+            1.0,
+            pitch_deg=0.0,
+            eyes=eyes_of(eye_yaw=eye_yaw),
+        ),
+        None,
+    )
+    verdict = probe.verdict
+    assert verdict.eyes.gaze_source == "eyes"
+    assert abs(verdict.eyes.gaze_yaw_deg - head_yaw) > 10.0  # the eyes did read turned back
+    assert verdict.gaze is Gaze.OFF_ROAD and verdict.zone == zone
+
+
+@pytest.mark.parametrize(
     ("closed_s", "expected"),
     [
         (1.5, ["microsleep:warning", "cleared:info"]),

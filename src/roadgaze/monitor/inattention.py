@@ -129,20 +129,23 @@ def _classify(
     if sample.face:
         if yaw is None:  # a face whose yaw the model cannot explain: keep the last decision
             zone = state.face_zone
-        elif _eyes_moved(
-            eyes, yaw, state.neutral_pitch_deg if pitch is None else pitch
-        ):  # an eye glance: judged on the gaze, narrower road
-            gaze_zones = eye_zone_map(zones, config.eyes_road_margin_deg)
-            zone = gaze_zones.classify(
-                (eyes.gaze_yaw_deg or 0.0) - state.neutral_yaw_deg,
-                (eyes.gaze_pitch_deg or 0.0) - state.neutral_pitch_deg,
-                state.face_zone,
-            )
-            gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
-            return _Look(gaze, zone, zone, yaw, pitch, None, False, by_eyes=True)
         else:
             pitch_offset = 0.0 if pitch is None else pitch - state.neutral_pitch_deg
             zone = zones.classify(yaw - state.neutral_yaw_deg, pitch_offset, state.face_zone)
+            if _eyes_moved(eyes, yaw, state.neutral_pitch_deg if pitch is None else pitch):
+                # An eye glance: judged on the gaze, on a narrower road. The eyes may take the
+                # gaze off a road the head is on, never back onto it: a head judged off road
+                # stays off road (fail-safe; MediaPipe's eye direction is least reliable with
+                # the head turned, where it can read the eyes turned back by 15-20 deg).
+                gaze_zones = eye_zone_map(zones, config.eyes_road_margin_deg)
+                gaze_zone = gaze_zones.classify(
+                    (eyes.gaze_yaw_deg or 0.0) - state.neutral_yaw_deg,
+                    (eyes.gaze_pitch_deg or 0.0) - state.neutral_pitch_deg,
+                    state.face_zone,
+                )
+                if gaze_zone != ROAD or zone == ROAD:
+                    gaze = Gaze.ON_ROAD if gaze_zone == ROAD else Gaze.OFF_ROAD
+                    return _Look(gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, by_eyes=True)
         gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
         return _Look(gaze, zone, zone, yaw, pitch, None, False)
     if state.face_lost_since_s is not None:

@@ -98,18 +98,6 @@ def subscriber_config(config: Config, port: int) -> Config:
     return config.model_copy(update={"zenoh": zenoh})
 
 
-def wait_for_liveliness(session: Any, key: str, timeout_s: float) -> bool:
-    """True once a liveliness token matching `key` answers in `session`; False after
-    `timeout_s`."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        replies = session.liveliness().get(key, timeout=0.5)
-        if any(reply.ok is not None for reply in replies):
-            return True
-        time.sleep(0.05)
-    return False
-
-
 class AlertSubscriber:
     """A Zenoh subscriber to the alert key in its own session; appends each alert to a file.
 
@@ -122,20 +110,16 @@ class AlertSubscriber:
         alerts_path: Path,
         on_alert: Callable[[dict[str, Any]], None],
     ) -> None:
-        from roadgaze.transport import Keys, open_session, plan_session
+        from roadgaze.transport import Subscription
 
-        self.keys = Keys.from_config(config.zenoh)
         self._on_alert = on_alert
         self._lock = threading.Lock()
         self.received: list[dict[str, Any]] = []
         self._file = alerts_path.open("w", encoding="utf-8")
-        self._session: Any = None
-        self._subscriber: Any = None
         try:
-            self._session = open_session(plan_session(config.zenoh, "consumer", mode="peer"))
-            self._subscriber = self._session.declare_subscriber(self.keys.alert, self._on_sample)
+            self._subscription = Subscription(config, lambda keys: keys.alert, self._on_sample)
         except BaseException:
-            self.close()
+            self._file.close()
             raise
 
     def _on_sample(self, sample: Any) -> None:
@@ -154,26 +138,19 @@ class AlertSubscriber:
 
     def wait_for_publisher(self, timeout_s: float) -> bool:
         """True once the publisher's liveliness token is visible (routes are then in place)."""
-        return wait_for_liveliness(self._session, self.keys.alive, timeout_s)
+        return self._subscription.wait_for_publisher(timeout_s)
 
     def wait_for_count(self, count: int, timeout_s: float) -> bool:
         """True once `count` alerts have arrived; False after `timeout_s`."""
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
+
+        def arrived() -> bool:
             with self._lock:
-                if len(self.received) >= count:
-                    return True
-            time.sleep(0.02)
-        with self._lock:
-            return len(self.received) >= count
+                return len(self.received) >= count
+
+        return self._subscription.wait_until(arrived, timeout_s)
 
     def close(self) -> None:
-        if self._subscriber is not None:
-            self._subscriber.undeclare()
-            self._subscriber = None
-        if self._session is not None:
-            self._session.close()
-            self._session = None
+        self._subscription.close()
         with self._lock:
             self._file.close()
 

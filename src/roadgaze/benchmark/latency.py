@@ -54,23 +54,15 @@ class YawLatencyProbe:
     """A Zenoh subscriber to the yaw key; records receipt time minus capture stamp per message."""
 
     def __init__(self, config: Config, stamps: CaptureStamps) -> None:
-        from roadgaze.transport import Keys, open_session, plan_session
+        from roadgaze.transport import Subscription
 
-        self.keys = Keys.from_config(config.zenoh)
         self._stamps = stamps
         self._lock = threading.Lock()
         self._latencies_s: list[float] = []
         self._parts_s: list[tuple[float, float]] = []
         self.received = 0
         self.undecodable = 0
-        self._session: Any = None
-        self._subscriber: Any = None
-        try:
-            self._session = open_session(plan_session(config.zenoh, "consumer", mode="peer"))
-            self._subscriber = self._session.declare_subscriber(self.keys.yaw, self._on_sample)
-        except BaseException:
-            self.close()
-            raise
+        self._subscription = Subscription(config, lambda keys: keys.yaw, self._on_sample)
 
     def _on_sample(self, sample: Any) -> None:
         arrived = time.perf_counter()
@@ -94,18 +86,14 @@ class YawLatencyProbe:
 
     def wait_for_publisher(self, timeout_s: float) -> bool:
         """True once the publisher's liveliness token is visible (routes are then in place)."""
-        from roadgaze.demo import wait_for_liveliness
-
-        return wait_for_liveliness(self._session, self.keys.alive, timeout_s)
+        return self._subscription.wait_for_publisher(timeout_s)
 
     def wait_for_count(self, count: int, timeout_s: float) -> bool:
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
+        def arrived() -> bool:
             with self._lock:
-                if self.received >= count:
-                    return True
-            time.sleep(0.02)
-        return False
+                return self.received >= count
+
+        return self._subscription.wait_until(arrived, timeout_s)
 
     def result(self, published: int) -> LatencyResult:
         with self._lock:
@@ -129,12 +117,7 @@ class YawLatencyProbe:
         )
 
     def close(self) -> None:
-        if self._subscriber is not None:
-            self._subscriber.undeclare()
-            self._subscriber = None
-        if self._session is not None:
-            self._session.close()
-            self._session = None
+        self._subscription.close()
 
 
 @dataclass(frozen=True, slots=True)

@@ -37,6 +37,7 @@ from roadgaze.transport.session import (
     zenoh_error_text,
 )
 from roadgaze.transport.speed import SPEED_MAX_KMH, SpeedInput, parse_speed_kmh
+from roadgaze.transport.subscription import Subscription
 from roadgaze.transport.throttle import ThrottledWarning
 from roadgaze.transport.vss import (
     VSS_PATHS,
@@ -73,6 +74,7 @@ __all__ = [
     "SessionPlan",
     "SpeedInput",
     "StateMessage",
+    "Subscription",
     "ThrottledWarning",
     "TransportStatus",
     "VssLink",

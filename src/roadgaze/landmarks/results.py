@@ -7,6 +7,13 @@ an array (another 0.9 ms). Where MediaPipe's Python package talks to its C libra
 `detect`/`detect_for_video` calls and reads the landmark array straight out of the C result
 (0.05 ms); with any other MediaPipe it uses the public API and one vectorised conversion. Both give
 identical numbers (tested).
+
+MediaPipe >= 1.0 runs each C call of a landmarker on a thread of its own (`SerialDispatcher`, so
+that one landmarker is never called from two threads at once): two thread hand-overs per call.
+roadgaze calls a landmarker from one thread at a time (the loop's landmark thread), so it calls
+the C function the dispatcher wraps on that thread, with the same arguments and MediaPipe's own
+status check (`_raw_library`); the hand-overs cost 0.1-0.5 ms per frame, more while the other
+core is busy.
 """
 
 from __future__ import annotations
@@ -100,6 +107,25 @@ def _reader() -> _CResultReader | None:
     return _CResultReader.find()
 
 
+@functools.cache
+def _status_check() -> Any:
+    """MediaPipe's `handle_status(status, error_message)`; None where it is not found."""
+    try:
+        utils = importlib.import_module("mediapipe.tasks.python.core.mediapipe_c_utils")
+    except ImportError:
+        return None
+    return getattr(utils, "handle_status", None)
+
+
+def _raw_library(landmarker: Any) -> Any | None:
+    """The `ctypes.CDLL` behind the landmarker's `SerialDispatcher`, None where there is none."""
+    raw = getattr(getattr(landmarker, "_lib", None), "_lib", None)
+    needed = ("MpFaceLandmarkerDetectForVideo", "MpFaceLandmarkerDetectImage", "MpErrorFree")
+    if not isinstance(raw, ctypes.CDLL) or _status_check() is None:
+        return None
+    return raw if all(hasattr(raw, name) for name in needed) else None
+
+
 def uses_c_results(landmarker: Any) -> bool:
     """True when `run_landmarker` reads this landmarker's results straight from the C library."""
     lib = getattr(landmarker, "_lib", None)
@@ -145,18 +171,28 @@ def run_landmarker(
 def _run_direct(
     landmarker: Any, image: Any, timestamp_ms: int | None, reader: _CResultReader
 ) -> list[FaceArrays]:
-    """What `detect`/`detect_for_video` do, minus the per-landmark Python objects."""
+    """What `detect`/`detect_for_video` do, minus the per-landmark Python objects (and, where
+    MediaPipe dispatches its C calls to a thread of its own, minus the hand-overs)."""
     lib = landmarker._lib
+    raw = _raw_library(landmarker)
     result = reader.result_type()
-    if timestamp_ms is None:
-        lib.MpFaceLandmarkerDetectImage(
-            landmarker._handle, image._image_ptr, None, ctypes.byref(result)
-        )
+    args: tuple[Any, ...] = (landmarker._handle, image._image_ptr, None)
+    if timestamp_ms is not None:
+        args += (timestamp_ms,)
+    name = (
+        "MpFaceLandmarkerDetectImage" if timestamp_ms is None else "MpFaceLandmarkerDetectForVideo"
+    )
+    if raw is None:
+        getattr(lib, name)(*args, ctypes.byref(result))
     else:
-        lib.MpFaceLandmarkerDetectForVideo(
-            landmarker._handle, image._image_ptr, None, timestamp_ms, ctypes.byref(result)
-        )
+        error = ctypes.c_char_p()
+        status = getattr(raw, name)(*args, ctypes.byref(result), ctypes.byref(error))
+        try:
+            _status_check()(status, error)
+        finally:
+            if error.value is not None:
+                raw.MpErrorFree(error)
     try:
         return reader.read(result)
     finally:
-        lib.MpFaceLandmarkerCloseResult(ctypes.byref(result))
+        (lib if raw is None else raw).MpFaceLandmarkerCloseResult(ctypes.byref(result))

@@ -83,6 +83,7 @@ def test_a_file_is_decoded_inferred_and_measured_on_three_threads_in_order() -> 
     # The same records as one frame at a time on this thread.
     one_by_one = Pipeline(StagedDetector(yaws(40)))
     expected = [one_by_one.process(frame).record for frame in ListSource(40)]
+
     def values(record: Any) -> tuple[Any, ...]:
         sample = record.sample
         return (sample.t_s, sample.yaw_raw_deg, sample.yaw_deg, sample.yaw_rate_dps, record.verdict)

@@ -29,6 +29,7 @@ from roadgaze.landmarks.features import (
     features_from_landmarks,
 )
 from roadgaze.landmarks.multi_face import (
+    BackgroundCount,
     FaceCounter,
     FaceMode,
     MultiFaceSwitch,
@@ -144,6 +145,7 @@ class MediaPipeLandmarker(ClosesOnExit):
         self._mirror_landmarker: Any = None
         self._single_landmarker: Any = None
         self._counter: FaceCounter | None = None
+        self._background: BackgroundCount | None = None
         self._switch: MultiFaceSwitch | None = None
         self._started: set[int] = set()
         """Landmarkers (by id) that have run once."""
@@ -164,6 +166,7 @@ class MediaPipeLandmarker(ClosesOnExit):
                     self._counter = FaceCounter(
                         detector_model, landmarks_config.min_detection_confidence
                     )
+                    self._background = BackgroundCount(self._counter)
                     self._switch = MultiFaceSwitch(landmarks_config.multi_face_check_s)
         except (RuntimeError, ValueError, OSError) as exc:
             self.close()
@@ -288,10 +291,16 @@ class MediaPipeLandmarker(ClosesOnExit):
         self, mp_image: Any, size: tuple[int, int], t_s: float, timestamp_ms: int | None
     ) -> list[FoundFace]:
         """One frame of a stream: the one-face landmarker unless a count sees several faces."""
-        switch, counter = self._switch, self._counter
-        assert switch is not None and counter is not None
+        switch, counter, background = self._switch, self._counter, self._background
+        assert switch is not None and counter is not None and background is not None
+        finished = background.finished()
+        if finished is not None:
+            switch.counted(*finished)
         if switch.check_due(t_s):
-            switch.counted(t_s, counter.count(mp_image))
+            if switch.next_check_t_s is None:  # the first frame: counted before it is tracked
+                switch.counted(t_s, counter.count(mp_image))
+            else:  # the periodic count, taken a frame or two later (the check period is 1 s)
+                background.start(t_s, mp_image)
         if switch.mode is FaceMode.SINGLE:
             faces = self._find(self._single_landmarker, mp_image, size, timestamp_ms)
             if not faces and switch.previous_box is not None:
@@ -352,7 +361,8 @@ class MediaPipeLandmarker(ClosesOnExit):
 
     def close(self) -> None:
         with filtered_native_stderr():
-            for name in ("_landmarker", "_mirror_landmarker", "_single_landmarker", "_counter"):
+            names = ("_background", "_landmarker", "_mirror_landmarker", "_single_landmarker")
+            for name in (*names, "_counter"):
                 resource = getattr(self, name, None)
                 if resource is not None:
                     resource.close()

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from roadgaze.config import Config
 from roadgaze.pipeline import Sink, SpeedSource, no_speed
-from roadgaze.signals import StopFlag, signal_handlers
+from roadgaze.service.signals import StopFlag, signal_handlers
 from roadgaze.transport import BusPublisher, Health, Keys, SpeedInput, ZenohLink
 from roadgaze.transport.vss import VSS_PATHS, VssPublisher, vss_key
 
@@ -82,11 +82,11 @@ def run_daemon(
     A camera that cannot be opened is waited for with backoff (capture.reconnect_*) and reported
     in the state as degraded; a missing file is a `SourceError`. An unreachable Zenoh peer never
     stops monitoring (see `ZenohLink`). Under systemd (`$NOTIFY_SOCKET`) it sends READY, WATCHDOG
-    and STOPPING notifications (see `roadgaze.supervision`).
+    and STOPPING notifications (see `roadgaze.service.supervision`).
     """
     from roadgaze import capture
     from roadgaze.pipeline import Pipeline, create_detector
-    from roadgaze.supervision import Supervisor
+    from roadgaze.service.supervision import Supervisor
 
     stop = stop if stop is not None else StopFlag()
     with ExitStack() as stack:

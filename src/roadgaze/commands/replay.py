@@ -179,7 +179,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.errors import ConfigError
     from roadgaze.outputs.video import FOURCC_BY_SUFFIX
     from roadgaze.pipeline import Pipeline, create_detector
-    from roadgaze.signals import sigterm_as_interrupt
+    from roadgaze.service.signals import sigterm_as_interrupt
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")

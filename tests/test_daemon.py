@@ -361,7 +361,7 @@ def test_daemon_reports_a_lost_camera_and_carries_on_when_it_is_back(
 
     import roadgaze.capture as capture
     from roadgaze.daemon import run_daemon
-    from roadgaze.signals import StopFlag
+    from roadgaze.service.signals import StopFlag
 
     recorder, port = hub
     image = synthetic_renderer.render(0.0)

@@ -30,7 +30,7 @@ PURE_MODULES = (
     "roadgaze.landmarks.features",
     "roadgaze.landmarks.driver",
     "roadgaze.landmarks.eyes",
-    "roadgaze.config_eyes",
+    "roadgaze.config",
     "roadgaze.eye_records",
     "roadgaze.evaluation.stats",
     "roadgaze.synth.timeline",

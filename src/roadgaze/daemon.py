@@ -16,8 +16,9 @@ from dataclasses import dataclass
 
 from roadgaze.config import Config
 from roadgaze.pipeline import Sink, SpeedSource, no_speed
-from roadgaze.signals import StopFlag, signal_handlers
+from roadgaze.service.signals import StopFlag, signal_handlers
 from roadgaze.transport import BusPublisher, Health, Keys, SpeedInput, ZenohLink
+from roadgaze.transport.health import ALERT_LOG
 from roadgaze.transport.vss import VSS_PATHS, VssPublisher, vss_key
 
 log = logging.getLogger("roadgaze.daemon")
@@ -34,12 +35,14 @@ class BusOutputs:
 
 
 @contextmanager
-def bus_outputs(config: Config, source_label: str, publish: bool) -> Iterator[BusOutputs]:
+def bus_outputs(
+    config: Config, source_label: str, publish: bool, *, log_name: str = ALERT_LOG
+) -> Iterator[BusOutputs]:
     """`Health` (always) and, when `publish`, the Zenoh link and its publisher; on exit the final
-    state is published and everything undeclared."""
+    state is published and everything undeclared. Alerts are logged once under `log_name`."""
     keys = Keys.from_config(config.zenoh)
     if not publish:
-        health = Health(config, keys, None, source_label)
+        health = Health(config, keys, None, source_label, log_name=log_name)
         yield BusOutputs(health=health, sinks=(health,), speed=no_speed, link=None)
         return
     speed = SpeedInput(config.zenoh.speed_timeout_s) if keys.speed is not None else None
@@ -52,7 +55,7 @@ def bus_outputs(config: Config, source_label: str, publish: bool) -> Iterator[Bu
         speed=speed,
         vss_keys=tuple(vss_key(path, prefix) for path in VSS_PATHS) if config.zenoh.vss else (),
     )
-    health = Health(config, keys, link, source_label)
+    health = Health(config, keys, link, source_label, log_name=log_name)
     holder.append(health)
     sinks: tuple[Sink, ...] = (health, BusPublisher(keys.vehicle_id, link))
     if config.zenoh.vss:
@@ -82,11 +85,11 @@ def run_daemon(
     A camera that cannot be opened is waited for with backoff (capture.reconnect_*) and reported
     in the state as degraded; a missing file is a `SourceError`. An unreachable Zenoh peer never
     stops monitoring (see `ZenohLink`). Under systemd (`$NOTIFY_SOCKET`) it sends READY, WATCHDOG
-    and STOPPING notifications (see `roadgaze.supervision`).
+    and STOPPING notifications (see `roadgaze.service.supervision`).
     """
     from roadgaze import capture
     from roadgaze.pipeline import Pipeline, create_detector
-    from roadgaze.supervision import Supervisor
+    from roadgaze.service.supervision import Supervisor
 
     stop = stop if stop is not None else StopFlag()
     with ExitStack() as stack:

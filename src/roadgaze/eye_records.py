@@ -5,6 +5,11 @@
 project convention: yaw > 0 toward the person's own left, pitch > 0 up. "Right" and "left" are
 the person's own sides (MediaPipe's iris 468-472 and eyeBlinkRight are the person's right eye,
 on the image's left for an unmirrored camera).
+
+Part of the per-frame vocabulary: `roadgaze.types` re-exports these names (import them from
+there) and `Verdict.eyes` builds an `EyesVerdict` at run time. The file sits beside types.py, not
+in a stage folder, because every stage folder's `__init__` imports `roadgaze.types`: a home in
+one of them makes `import roadgaze.types` circular.
 """
 
 from __future__ import annotations

@@ -36,6 +36,16 @@ def listen(port: int, *args: str) -> subprocess.Popen[str]:
     )  # fmt: skip
 
 
+def stop_cleanly(process: subprocess.Popen[str]) -> str:
+    """SIGTERM `listen` as systemd would; its stderr, once it has exited 0 without a traceback."""
+    process.send_signal(signal.SIGTERM)
+    code = process.wait(timeout=20)
+    stderr = process.stderr.read() if process.stderr else ""
+    assert code == 0, stderr[-2000:]
+    assert "Traceback" not in stderr, stderr[-2000:]
+    return stderr
+
+
 def valid_state(**changes: Any) -> bytes:
     config = Config(zenoh=ZenohConfig(vehicle_id=VEHICLE))
     health = Health(config, Keys.from_config(config.zenoh), None, "test")
@@ -76,13 +86,9 @@ def test_hostile_payloads_are_reported_and_the_valid_alert_printed_once() -> Non
                 ALERT_KEY, alert_message(1, VEHICLE).to_json_bytes(), congestion_control=block
             )
             received = [json.loads(reader.next(10.0) or "null") for _ in range(2)]
-            process.send_signal(signal.SIGTERM)
-            code = process.wait(timeout=20)
-            stderr = process.stderr.read() if process.stderr else ""
+            stderr = stop_cleanly(process)
         finally:
             stop_process(process)
-    assert code == 0
-    assert "Traceback" not in stderr, stderr[-2000:]
     by_type = {record["type"]: record["payload"] for record in received}  # keys are not ordered
     assert sorted(by_type) == ["alert", "state"]
     assert by_type["state"]["source"] == "cam\ud800\x1b[2J"  # escaped by json.dumps
@@ -118,13 +124,9 @@ def test_vss_values_from_the_bus_are_checked_before_they_are_printed() -> None:
             attacker.put("Vehicle/Driver/FatigueLevel", b"60.0", congestion_control=block)
             attacker.put("Vehicle/Speed", b"57.5", congestion_control=block)  # another provider's
             received = [json.loads(reader.next(10.0) or "null") for _ in range(2)]
-            process.send_signal(signal.SIGTERM)
-            code = process.wait(timeout=20)
-            stderr = process.stderr.read() if process.stderr else ""
+            stderr = stop_cleanly(process)
         finally:
             stop_process(process)
-    assert code == 0
-    assert "Traceback" not in stderr, stderr[-2000:]
     assert json.loads(line) == {"type": "vss", "key": eyes_key, "value": "false"}
     assert sorted((r["key"], r["value"]) for r in received) == [
         ("Vehicle/Driver/FatigueLevel", "60.0"),

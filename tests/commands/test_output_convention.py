@@ -95,6 +95,8 @@ def test_replay_without_out_writes_the_records_to_stdout_and_the_rest_to_stderr(
     assert_logs_on_their_own_lines(err)
     logged = log_lines(err)
     assert sum("long_distraction" in line for line in logged) == 1  # told once, when raised
+    alert_loggers = [line.split()[3] for line in logged if line.split()[4] == "alert"]
+    assert alert_loggers == ["roadgaze.replay:"] * 2  # replay's own, not the daemon's
     assert sum("cleared" in line for line in logged) == 1
     [summary] = [line for line in logged if "frames, face in" in line]
     assert "2 alerts" in summary

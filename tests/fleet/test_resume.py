@@ -23,7 +23,7 @@ from fakes import die_on_crash_drives
 from repo_paths import child_env
 from roadgaze.config import Config
 from roadgaze.fleet import Drive, DriveTask, LocalEngine
-from roadgaze.signals import StopFlag
+from roadgaze.service.signals import StopFlag
 
 pytestmark = pytest.mark.slow
 

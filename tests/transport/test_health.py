@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 from collections.abc import Iterator
 
 import jsonschema
@@ -167,3 +168,36 @@ def test_alerts_are_gated_on_the_speed_received(
     state = health.state_message()
     assert state.monitor.speed_source == source
     assert state.monitor.moving is (expected > 0)
+
+
+class Collected(logging.Handler):
+    """Every record that reaches roadgaze's top logger (whatever its handlers and level were)."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.INFO)
+        self.records: list[logging.LogRecord] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.records.append(record)
+
+
+@pytest.mark.parametrize("log_name", [None, "roadgaze.replay"])
+def test_each_alert_is_logged_once_under_the_logger_its_caller_names(log_name: str | None) -> None:
+    keys = Keys.from_config(FIXED.zenoh)
+    if log_name is None:
+        health = Health(FIXED, keys, None, "test")
+    else:
+        health = Health(FIXED, keys, None, "test", log_name=log_name)
+    top = logging.getLogger("roadgaze")
+    collected, level = Collected(), top.level
+    top.addHandler(collected)
+    top.setLevel(logging.INFO)
+    try:
+        for record in records(FIXED, glance(180)):
+            health.on_record(record, BLANK_FRAME)
+    finally:
+        top.removeHandler(collected)
+        top.setLevel(level)
+    logged = [(r.name, r.getMessage().split()[1]) for r in collected.records if hasattr(r, "alert")]
+    expected = log_name or "roadgaze.daemon"
+    assert logged == [(expected, "long_distraction"), (expected, "cleared")]

@@ -71,7 +71,7 @@ def _say(text: str) -> None:
 
 def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.errors import TransportError
-    from roadgaze.signals import StopFlag, signal_handlers
+    from roadgaze.service.signals import StopFlag, signal_handlers
     from roadgaze.transport import Keys, build_zenoh_config, open_session, plan_session
 
     # Non-UTF-8 text (a lone surrogate in a hostile payload) is escaped, never a crash.

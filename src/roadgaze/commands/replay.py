@@ -179,7 +179,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.errors import ConfigError
     from roadgaze.outputs.video import FOURCC_BY_SUFFIX
     from roadgaze.pipeline import Pipeline, create_detector
-    from roadgaze.signals import sigterm_as_interrupt
+    from roadgaze.service.signals import sigterm_as_interrupt
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
@@ -195,7 +195,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
         source = stack.enter_context(open_source(args.source, config))
         detector = create_detector(config)
         stack.callback(detector.close)
-        bus = stack.enter_context(bus_outputs(config, args.source, args.publish))
+        bus = stack.enter_context(bus_outputs(config, args.source, args.publish, log_name=log.name))
         sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack, config)]
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)

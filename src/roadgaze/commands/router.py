@@ -40,7 +40,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
-    from roadgaze.signals import StopFlag, signal_handlers
+    from roadgaze.service.signals import StopFlag, signal_handlers
 
     stop = StopFlag()
     # Before zenoh is imported: a stop asked for during start-up is kept.

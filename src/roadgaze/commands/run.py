@@ -33,7 +33,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
-    from roadgaze.signals import StopFlag, signal_handlers
+    from roadgaze.service.signals import StopFlag, signal_handlers
 
     stop = StopFlag()
     # Handlers before the heavy imports: as PID 1 of a container, a SIGTERM arriving while

@@ -19,8 +19,42 @@ CAMERA_TIMEOUT_S = 3.0
 T = TypeVar("T")
 
 
+def explicit_model_check(config: Config, found: Path | None) -> list[Check]:
+    """A WARN when `model.path` or $ROADGAZE_MODEL_PATH names a file that is not a verified model.
+
+    `run` then does what `model_store.resolve_model` does: it uses `found` (the cache) or
+    downloads, never that file, so the check names what is used instead. Nothing when no
+    explicit path is set or it is the model found.
+    """
+    from roadgaze.landmarks.model_store import ENV_MODEL_PATH, check_file, explicit_model_path
+
+    explicit = explicit_model_path(config.model)
+    if explicit is None or explicit == found:
+        return []
+    problem = check_file(explicit)
+    if problem is None:  # became valid since it was looked at
+        return []
+    origin = "model.path" if config.model.path is not None else f"${ENV_MODEL_PATH}"
+    if found is not None:
+        instead = f"uses {found} instead"
+    elif config.model.allow_download:
+        instead = "downloads the model into the cache instead"
+    else:
+        instead = "finds no model (next line)"
+    return [
+        Check(
+            "model",
+            Status.WARN,
+            f"{origin} names {explicit}: {problem}; roadgaze run ignores it and {instead}",
+            f"point {origin} at a verified face_landmarker.task, or unset it "
+            "(roadgaze model verify checks it)",
+        )
+    ]
+
+
 def check_model(config: Config) -> list[Check]:
-    """The model file: where, size and SHA-256, and whether MediaPipe loads it."""
+    """The model file: where, size and SHA-256, and whether MediaPipe loads it; a WARN first
+    when an explicit path names a file `run` cannot use."""
     from roadgaze.landmarks.model_store import (
         MODEL_FILE,
         MODEL_FILENAME,
@@ -29,34 +63,37 @@ def check_model(config: Config) -> list[Check]:
     )
 
     found, tried = find_local_model(config.model)
+    checks = explicit_model_check(config, found)
     if found is None:
         cache_file = default_cache_dir(config.model) / MODEL_FILENAME
         if config.model.allow_download:
             return [
+                *checks,
                 Check(
                     "model",
                     Status.WARN,
                     f"no model file yet ({'; '.join(tried)}); it is downloaded into {cache_file} "
                     "on first use",
                     "roadgaze model fetch (now, while there is a network)",
-                )
+                ),
             ]
         return [
+            *checks,
             Check(
                 "model",
                 Status.FAIL,
                 f"no model file ({'; '.join(tried)}) and model.allow_download = false",
                 "roadgaze model fetch, or place the file (see roadgaze model path)",
-            )
+            ),
         ]
-    checks = [
+    checks.append(
         Check(
             "model",
             Status.OK,
             f"{found}: {found.stat().st_size:,} bytes, SHA-256 {MODEL_FILE.sha256[:12]}... "
             "verified",
         )
-    ]
+    )
     problem = landmarker_problem(found)
     if problem is not None:
         checks.append(Check("model", Status.FAIL, f"MediaPipe cannot load it: {problem}",

@@ -30,7 +30,7 @@ from roadgaze.fleet.tables import (
     write_text_atomically,
 )
 from roadgaze.fleet.task import DriveTask, find_done
-from roadgaze.signals import StopFlag, signal_handlers
+from roadgaze.service.signals import StopFlag, signal_handlers
 
 SUMMARY_NAME = "summary.parquet"
 REPORT_NAME = "report.html"

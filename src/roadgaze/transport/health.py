@@ -1,6 +1,7 @@
 """The service's health: counters, status and problems, answered on the `state` key.
 
-`Health` is a pipeline sink. It counts frames, faces and alerts, logs each alert once and builds
+`Health` is a pipeline sink. It counts frames, faces and alerts, logs each alert once (under
+`roadgaze.daemon`, or the logger its caller names: `replay` logs them as its own) and builds
 the `StateMessage` the state queryable answers (thread-safe: it reads only immutable records and
 plain counters). The link logs its own changes (`LinkState`, from Zenoh's transport events).
 """
@@ -27,7 +28,8 @@ from roadgaze.transport.messages import (
 from roadgaze.transport.publisher import MessageLink
 from roadgaze.types import Alert, Frame, FrameRecord
 
-log = logging.getLogger("roadgaze.daemon")
+ALERT_LOG = "roadgaze.daemon"
+"""The logger of the alert lines unless the caller names another."""
 
 Status = Literal["starting", "running", "degraded", "stopping", "stopped"]
 RECENT_ALERTS = 100
@@ -44,12 +46,14 @@ class Health:
         link: MessageLink | None,
         source_label: str,
         wall_clock: Callable[[], float] = time.time,
+        log_name: str = ALERT_LOG,
     ) -> None:
         self.config = config
         self.keys = keys
         self.link = link
         self.source_label = source_label
         self._wall_clock = wall_clock
+        self._log = logging.getLogger(log_name)
         self._started = time.monotonic()
         self.status: Status = "starting"
         self.source: FrameSource | None = None
@@ -73,7 +77,7 @@ class Health:
             )
             self.alerts_raised += 1
             self.recent_alerts.append(alert)
-            log.info(
+            self._log.info(
                 "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)%s",
                 alert.kind.value,
                 alert.level.value,

@@ -31,7 +31,7 @@ from types import TracebackType
 from typing import Protocol, Self
 
 from roadgaze.capture import FrameSource, SourceStatus
-from roadgaze.sdnotify import Notifier
+from roadgaze.service.sdnotify import Notifier
 from roadgaze.types import Frame, FrameRecord
 
 log = logging.getLogger("roadgaze.daemon")

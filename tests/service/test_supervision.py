@@ -19,15 +19,15 @@ import pytest
 
 import roadgaze.capture as capture
 import roadgaze.pipeline as pipeline
-import roadgaze.supervision as supervision
+import roadgaze.service.supervision as supervision
 from fakes import FakeCamera, FakeNotifySocket, ListSource, ScriptedDetector
 from repo_paths import child_env
 from roadgaze.capture import SourceInfo, SourceStatus
 from roadgaze.config import Config
 from roadgaze.daemon import run_daemon
-from roadgaze.sdnotify import Notifier
-from roadgaze.signals import StopFlag
-from roadgaze.supervision import Supervisor, waiting_for_camera
+from roadgaze.service.sdnotify import Notifier
+from roadgaze.service.signals import StopFlag
+from roadgaze.service.supervision import Supervisor, waiting_for_camera
 from zenoh_helpers import LineReader, stop_process, wait_for
 
 WATCHDOG_USEC = 1_000_000

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from fakes import FakeNotifySocket
-from roadgaze.sdnotify import Notifier, socket_address
+from roadgaze.service.sdnotify import Notifier, socket_address
 from zenoh_helpers import wait_for
 
 

@@ -1,7 +1,7 @@
 """The eye settings: `[eyes]` (measurement) and the monitor's eye thresholds (in `[monitor]`).
 
-Kept apart from `roadgaze.config`, which imports them; defaults and their sources are in
-docs/eyes.md and docs/monitor.md.
+Kept apart from `roadgaze.config.settings`, which builds `[monitor]` on them; defaults and their
+sources are in docs/eyes.md and docs/monitor.md.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from roadgaze.config_section import Section
+from roadgaze.config.section import Section
 
 
 class EyesConfig(Section):

@@ -1,6 +1,6 @@
 """The `[zenoh]` configuration section: session, endpoints, key templates and bus limits (pure).
 
-Re-exported by `roadgaze.config` (split from it to keep files small).
+Part of `Config` (`roadgaze.config.settings`); its names are re-exported by `roadgaze.config`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any, Literal, Self
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from roadgaze.config_section import Section
+from roadgaze.config.section import Section
 
 VEHICLE_ID_PATTERN = r"^[A-Za-z0-9_-]{1,64}$"
 """Vehicle ids: letters, digits, '_' and '-', at most 64 (no wildcard, no '/', no empty id)."""

@@ -144,6 +144,54 @@ def test_no_model_file(
     assert check.fix is not None and "roadgaze model fetch" in check.fix
 
 
+@pytest.mark.parametrize("explicit_file", ["missing", "corrupt"])
+@pytest.mark.parametrize(
+    ("cached", "allow", "expected"),
+    [
+        (True, False, [Status.WARN, Status.OK]),
+        (False, True, [Status.WARN, Status.WARN]),
+        (False, False, [Status.WARN, Status.FAIL]),
+    ],
+)
+def test_an_explicit_model_path_run_cannot_use_is_never_ok(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    explicit_file: str,
+    cached: bool,
+    allow: bool,
+    expected: list[Status],
+) -> None:
+    """$ROADGAZE_MODEL_PATH naming a missing or corrupt file: doctor warns and says what `run`
+    (resolve_model) uses instead; it fails only when `run` would find no model at all."""
+    from roadgaze.errors import ModelError
+    from roadgaze.landmarks.model_store import resolve_model
+
+    monkeypatch.delenv("ROADGAZE_MODEL_PATH", raising=False)
+    cache_dir = resolve_model(Config().model).parent if cached else tmp_path / "empty-cache"
+    explicit = tmp_path / "face_landmarker.task"
+    if explicit_file == "corrupt":
+        explicit.write_bytes(b"not a model")
+    monkeypatch.setenv("ROADGAZE_MODEL_PATH", str(explicit))
+    monkeypatch.setattr(service, "landmarker_problem", lambda path: None)
+    config = config_with(cache_dir=str(cache_dir), allow_download=allow)
+
+    checks = check_model(config)
+
+    assert statuses(checks) == expected
+    warning = checks[0]
+    problem = "not found" if explicit_file == "missing" else "size 11 bytes, expected 3758596"
+    assert f"$ROADGAZE_MODEL_PATH names {explicit}: {problem}" in warning.detail
+    assert warning.fix is not None and "ROADGAZE_MODEL_PATH" in warning.fix
+    if cached:  # run really uses the cached file the warning names
+        used = resolve_model(config.model, sources=[])
+        assert used != explicit and f"ignores it and uses {used} instead" in warning.detail
+    elif allow:
+        assert "downloads the model into the cache instead" in warning.detail
+    else:
+        with pytest.raises(ModelError):
+            resolve_model(config.model, sources=[])
+
+
 def test_a_model_mediapipe_cannot_load_fails(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(service, "landmarker_problem", lambda path: "bad flatbuffer")
     checks = check_model(load_config(environ={}))

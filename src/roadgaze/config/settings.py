@@ -17,12 +17,9 @@ from typing import TYPE_CHECKING, Any, Literal, Self
 
 from pydantic import Field, ValidationError, field_validator, model_validator
 
-from roadgaze.config_eyes import EyeMonitorSettings
-from roadgaze.config_eyes import EyesConfig as EyesConfig
-from roadgaze.config_section import Section as _Section
-from roadgaze.config_zenoh import VEHICLE_ID_PATTERN as VEHICLE_ID_PATTERN
-from roadgaze.config_zenoh import ZenohConfig as ZenohConfig
-from roadgaze.config_zenoh import check_key_template as check_key_template
+from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
+from roadgaze.config.section import Section as _Section
+from roadgaze.config.zenoh import ZenohConfig
 from roadgaze.errors import ConfigError
 
 if TYPE_CHECKING:

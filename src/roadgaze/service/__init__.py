@@ -1,0 +1,16 @@
+"""Service plumbing around the daemon's loop: stop signals, systemd's notify protocol, watchdog."""
+
+from roadgaze.service.sdnotify import Notifier, socket_address
+from roadgaze.service.signals import STOP_SIGNALS, StopFlag, signal_handlers, sigterm_as_interrupt
+from roadgaze.service.supervision import Supervisor, waiting_for_camera
+
+__all__ = [
+    "STOP_SIGNALS",
+    "Notifier",
+    "StopFlag",
+    "Supervisor",
+    "signal_handlers",
+    "sigterm_as_interrupt",
+    "socket_address",
+    "waiting_for_camera",
+]

@@ -9,8 +9,7 @@ Under the prefix (default `vehicle/{vehicle_id}/dms`):
   docs/zenoh.md) gets every alert in order: those of a link outage from the cache once the link
   is back, and the last ones when it joins late. Plain subscribers get what is published while
   they are connected.
-- `yaw`: one `YawMessage` per frame, congestion control DROP, priority DATA (droppable),
-  express (sent at once, not held for a batch).
+- `yaw`: one `YawMessage` per frame, congestion control DROP, priority DATA (droppable).
 - `alive`: a liveliness token, present while the daemon runs.
 - `state`: a queryable answering a `StateMessage` from a bounded thread (`StateResponder`).
 - with `vss_keys`, one text publisher per COVESA VSS signal (`roadgaze.transport.vss`):
@@ -97,7 +96,6 @@ class _Declared:
                 encoding=zenoh.Encoding.APPLICATION_JSON,
                 congestion_control=zenoh.CongestionControl.DROP,
                 priority=zenoh.Priority.DATA,
-                express=True,  # one message per frame: sent at once, not batched
             )
             self._entities.append(self.yaw)
             if link.speed is not None and keys.speed is not None:

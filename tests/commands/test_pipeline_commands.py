@@ -142,6 +142,8 @@ def test_bench_latency_through_a_loopback_subscriber(capsys: pytest.CaptureFixtu
     # Delivery cannot be faster than the landmark stage that precedes it.
     assert 0 < latency["landmarks_p50_ms"] <= latency["landmarks_p99_ms"]
     assert latency["p50_ms"] >= latency["landmarks_p50_ms"]
+    assert latency["stages"]["landmarks"]["p99_ms"] == latency["landmarks_p99_ms"]
+    assert set(latency["stages"]) == set(result["stages"])
     assert latency["target_p99_ms"] == pytest.approx(latency["landmarks_p99_ms"] + 2.0, abs=2e-3)
     assert latency["meets_target"] == (latency["p99_ms"] <= latency["target_p99_ms"])
     # The two parts: in the loop up to the publish (at least the landmark stage), then Zenoh.

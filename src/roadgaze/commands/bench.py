@@ -201,8 +201,13 @@ class LatencyPass:
     """The latency pass: capture to delivery, and the same frames' landmark stage."""
 
     latency: LatencyResult
-    landmarks: StageStats | None
+    stages: dict[str, StageStats]
+    """This pass's per-stage times (the first `--warmup` frames left out)."""
     frames: int
+
+    @property
+    def landmarks(self) -> StageStats | None:
+        return self.stages.get("landmarks")
 
 
 def latency_pass(args: argparse.Namespace, config: Config) -> LatencyPass:
@@ -219,7 +224,7 @@ def latency_pass(args: argparse.Namespace, config: Config) -> LatencyPass:
         published = result.summary.frames
         rig.probe.wait_for_count(published, 5.0)
         latency = rig.probe.result(published, skip_first=args.warmup)
-    return LatencyPass(latency, timings.stats().get("landmarks"), published)
+    return LatencyPass(latency, timings.stats(), published)
 
 
 def _round(value: float | None, digits: int) -> float | None:
@@ -289,6 +294,10 @@ def bench_result(
         target_ms = None if pass_landmarks is None else pass_landmarks.p99_ms + LATENCY_MARGIN_MS
         result["latency"] = {
             "paced": True,
+            "stages": {
+                stage: {"median_ms": round(stats.median_ms, 3), "p99_ms": round(stats.p99_ms, 3)}
+                for stage, stats in latency_run.stages.items()
+            },
             "landmarks_p50_ms": None
             if pass_landmarks is None
             else _round(pass_landmarks.median_ms, 3),

@@ -169,13 +169,14 @@ def markdown(
         f"{raw.get('median_ratio_to_raw')} | same |",
         f"| CPU per frame | {bench_run['cpu_ms_per_frame']} ms (MediaPipe alone "
         f"{raw.get('cpu_ms_per_frame')} ms) | same |",
-        f"| capture to Zenoh delivery | p50 {latency.get('p50_ms')} ms, p99 "
-        f"{latency.get('p99_ms')} ms ({latency.get('received')} of {latency.get('published')} "
-        f"received; target p99 <= landmark p99 + 2 ms = {latency.get('target_p99_ms')} ms; of "
-        f"which up to the publish p50 {latency.get('to_publish_p50_ms')} / p99 "
-        f"{latency.get('to_publish_p99_ms')} ms, Zenoh delivery to the subscriber in the same "
-        f"process p50 {latency.get('delivery_p50_ms')} / p99 {latency.get('delivery_p99_ms')} ms) "
-        "| same |",
+        f"| capture to Zenoh delivery (a pass at the drive's frame rate) | p50 "
+        f"{latency.get('p50_ms')} ms, p99 {latency.get('p99_ms')} ms ({latency.get('received')} "
+        f"of {latency.get('published')} received; target p99 <= landmark p99 "
+        f"{latency.get('landmarks_p99_ms')} + 2 ms = {latency.get('target_p99_ms')} ms: "
+        f"{'met' if latency.get('meets_target') else 'not met'}; of which up to the publish p50 "
+        f"{latency.get('to_publish_p50_ms')} / p99 {latency.get('to_publish_p99_ms')} ms, Zenoh "
+        f"delivery to a subscriber in another process p50 {latency.get('delivery_p50_ms')} / p99 "
+        f"{latency.get('delivery_p99_ms')} ms) | same |",
     ]
     if soak_run is not None:
         memory = soak_run["memory"]

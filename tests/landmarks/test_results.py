@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import cv2
 import mediapipe as mp
@@ -97,3 +98,27 @@ def test_objects_without_the_c_interface_use_the_public_api() -> None:
     [(points, matrix, scores)] = run_landmarker(Public(), object(), None)
     np.testing.assert_array_equal(points, np.tile([0.5, 0.25, -0.125], (3, 1)).astype(np.float32))
     assert matrix is None and scores is None
+
+
+def test_the_c_call_runs_on_the_callers_thread_with_mediapipes_status_check(
+    model_path: Path,
+) -> None:
+    """MediaPipe's own wrapper hands every C call to a thread of its own; `run_landmarker` calls
+    the same function on the caller's thread (no hand-over), and a failed status still raises."""
+    image = mp.Image(image_format=mp.ImageFormat.SRGB, data=two_faces())
+    detector: Any = landmarker(model_path, video=True)
+    executor = detector._lib._executor
+    submit = executor.submit
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the call went through MediaPipe's dispatcher thread")
+
+    executor.submit = refuse
+    try:
+        assert len(run_landmarker(detector, image, 100)) == 2
+        with pytest.raises(ValueError, match=r"(?i)timestamp"):
+            run_landmarker(detector, image, 100)  # not after the previous timestamp
+        assert len(run_landmarker(detector, image, 133)) == 2
+    finally:
+        executor.submit = submit
+        detector.close()

@@ -69,7 +69,9 @@ def test_mirror_flip_negates_the_yaw(left: float, width: float, centre: float, c
     middle = left + width * (0.5 + centre)
     yaw = full_range_yaw_deg(left, right, middle, cue)
     mirrored = full_range_yaw_deg(-right, -left, -middle, -cue)
-    assert mirrored == pytest.approx(-yaw, abs=1e-9)
+    # The inputs round differently once mirrored (1e-16 relative); at the edge (nose on a
+    # boundary) asin's slope is infinite and that becomes up to sqrt(2e-16) rad, 1e-6 deg.
+    assert mirrored == pytest.approx(-yaw, abs=1e-6)
 
 
 @pytest.mark.parametrize("cue", [0.0, 40.0, 70.0])

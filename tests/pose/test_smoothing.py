@@ -244,3 +244,12 @@ def test_the_process_noise_is_filterpys_piecewise_white_acceleration(dt_s: float
     transition, noise = constant_velocity_model(dt_s, 300.0)
     np.testing.assert_allclose(noise, Q_discrete_white_noise(dim=2, dt=dt_s, var=300.0**2))
     np.testing.assert_array_equal(transition, [[1.0, dt_s], [0.0, 1.0]])
+
+
+def test_the_filters_inverse_of_its_1x1_innovation_covariance_is_numpys() -> None:
+    from roadgaze.pose.smoothing import _inverse_1x1
+
+    for value in np.random.default_rng(3).uniform(1e-4, 1e4, 1000):
+        matrix = np.array([[value]])
+        assert _inverse_1x1(matrix) == np.linalg.inv(matrix)  # bit for bit
+    assert AngleSmoother()._filter.inv is _inverse_1x1

@@ -1,23 +1,29 @@
 """Capture-to-delivery latency of the yaw messages, through a Zenoh subscriber on loopback.
 
 `measure_latency` opens the service's own publishing (`roadgaze.daemon.bus_outputs`, a peer
-listening on a free 127.0.0.1 port) and a second Zenoh session connected to it whose subscriber
-takes each yaw message as it arrives. The latency of a frame is the time from the moment the loop
-received the frame from its source (`Pipeline.frame_received_s`, kept per frame by a
-`CaptureStamps` sink placed before the publisher) to the moment the subscriber's callback has the
-decoded message, both on this process's `time.perf_counter`. On a live camera add up to one
-camera frame period that a frame may wait in the newest-frame slot.
+listening on a free 127.0.0.1 port) and, in a process of its own as a forward-collision system
+would be, a Zenoh session connected to it whose subscriber takes each yaw message as it arrives.
+The latency of a frame is the time from the moment the loop received the frame from its source
+(`Pipeline.frame_received_s`, kept per frame by a `CaptureStamps` sink placed before the
+publisher) to the moment the subscriber's callback has the decoded message; both are read on
+`time.perf_counter`, the system's monotonic clock on Linux, which both processes share. On a live
+camera add up to one camera frame period that a frame may wait in the newest-frame slot.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
+import math
+import multiprocessing
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from multiprocessing.connection import Connection
 from typing import Any
 
 import numpy as np
@@ -51,62 +57,72 @@ class LatencyResult:
 
 
 class YawLatencyProbe:
-    """A Zenoh subscriber to the yaw key; records receipt time minus capture stamp per message."""
+    """A Zenoh subscriber to the yaw key in a child process; latency = its arrival time of each
+    message minus the frame's capture stamp here."""
 
     def __init__(self, config: Config, stamps: CaptureStamps) -> None:
-        from roadgaze.transport import Subscription
-
         self._stamps = stamps
-        self._lock = threading.Lock()
-        self._latencies_s: list[float] = []
-        self._parts_s: list[tuple[float, float]] = []
-        self.received = 0
-        self.undecodable = 0
-        self._subscription = Subscription(config, lambda keys: keys.yaw, self._on_sample)
+        context = multiprocessing.get_context("spawn")  # no fork of MediaPipe's threads
+        self._connection, child_end = context.Pipe()
+        self._process = context.Process(
+            target=_subscriber_process,
+            args=(config, child_end),
+            name="roadgaze-latency-subscriber",
+            daemon=True,
+        )
+        self._process.start()
+        child_end.close()
+        ready = self._ask(("ready",), SUBSCRIBER_WAIT_S + 20.0)
+        if ready is not True:
+            self.close()
+            raise RuntimeError(f"the latency subscriber did not start: {ready}")
 
-    def _on_sample(self, sample: Any) -> None:
-        arrived = time.perf_counter()
+    def _ask(self, command: tuple[Any, ...], timeout_s: float) -> Any:
+        """Send `command` to the child and wait for its answer (None after `timeout_s`)."""
         try:
-            frame = int(json.loads(sample.payload.to_bytes())["frame"])
-        except (ValueError, KeyError, TypeError):
-            with self._lock:
-                self.undecodable += 1
-            return
-        stamps = self._stamps.pop(frame)
-        with self._lock:
-            self.received += 1
-            if stamps is not None:
-                received_s, published_s = stamps
-                if len(self._latencies_s) >= MAX_SAMPLES:
-                    del self._latencies_s[: MAX_SAMPLES // 10]
-                    del self._parts_s[: MAX_SAMPLES // 10]
-                self._latencies_s.append(arrived - received_s)
-                if published_s is not None:
-                    self._parts_s.append((published_s - received_s, arrived - published_s))
+            if command[0] != "ready":
+                self._connection.send(command)
+            if not self._connection.poll(timeout_s):
+                return None
+            return self._connection.recv()
+        except (EOFError, OSError):
+            return None
 
     def wait_for_publisher(self, timeout_s: float) -> bool:
         """True once the publisher's liveliness token is visible (routes are then in place)."""
-        return self._subscription.wait_for_publisher(timeout_s)
+        return self._ask(("publisher", timeout_s), timeout_s + 5.0) is True
 
     def wait_for_count(self, count: int, timeout_s: float) -> bool:
-        def arrived() -> bool:
-            with self._lock:
-                return self.received >= count
+        deadline = time.monotonic() + timeout_s
+        while True:
+            received = self._ask(("count",), 5.0)
+            if received is None or received >= count or time.monotonic() >= deadline:
+                return received is not None and received >= count
+            time.sleep(0.02)
 
-        return self._subscription.wait_until(arrived, timeout_s)
-
-    def result(self, published: int) -> LatencyResult:
-        with self._lock:
-            milliseconds = 1e3 * np.asarray(self._latencies_s)
-            parts_ms = 1e3 * np.asarray(self._parts_s).reshape(-1, 2)
-            received = self.received
+    def result(self, published: int, skip_first: int = 0) -> LatencyResult:
+        """Percentiles over the messages received, the first `skip_first` (model start-up) left
+        out."""
+        arrivals: list[tuple[int, float]] = self._ask(("arrivals",), 10.0) or []
+        latencies_s: list[float] = []
+        parts_s: list[tuple[float, float]] = []
+        for frame, arrived in arrivals[skip_first:]:
+            stamps = self._stamps.pop(frame)
+            if stamps is None:
+                continue
+            received_s, published_s = stamps
+            latencies_s.append(arrived - received_s)
+            if published_s is not None:
+                parts_s.append((published_s - received_s, arrived - published_s))
+        milliseconds = 1e3 * np.asarray(latencies_s)
+        parts_ms = 1e3 * np.asarray(parts_s).reshape(-1, 2)
         if milliseconds.size == 0:
-            return LatencyResult(published, received, float("nan"), float("nan"), float("nan"))
-        to_publish = np.percentile(parts_ms[:, 0], [50, 99]) if len(parts_ms) else [np.nan] * 2
-        delivery = np.percentile(parts_ms[:, 1], [50, 99]) if len(parts_ms) else [np.nan] * 2
+            return LatencyResult(published, len(arrivals), math.nan, math.nan, math.nan)
+        to_publish = np.percentile(parts_ms[:, 0], [50, 99]) if len(parts_ms) else [math.nan] * 2
+        delivery = np.percentile(parts_ms[:, 1], [50, 99]) if len(parts_ms) else [math.nan] * 2
         return LatencyResult(
             published=published,
-            received=received,
+            received=len(arrivals),
             p50_ms=float(np.median(milliseconds)),
             p99_ms=float(np.percentile(milliseconds, 99)),
             max_ms=float(np.max(milliseconds)),
@@ -117,7 +133,53 @@ class YawLatencyProbe:
         )
 
     def close(self) -> None:
-        self._subscription.close()
+        with contextlib.suppress(OSError, EOFError):
+            self._connection.send(("close",))
+        self._process.join(5.0)
+        if self._process.is_alive():
+            self._process.terminate()
+            self._process.join(1.0)
+        self._connection.close()
+
+
+def _subscriber_process(config: Config, connection: Connection) -> None:
+    """The child: subscribe, answer the parent's questions until it says close or goes away."""
+    from roadgaze.transport import Subscription
+
+    lock = threading.Lock()
+    arrivals: deque[tuple[int, float]] = deque(maxlen=MAX_SAMPLES)
+
+    def on_sample(sample: Any) -> None:
+        arrived = time.perf_counter()
+        try:
+            frame = int(json.loads(sample.payload.to_bytes())["frame"])
+        except (ValueError, KeyError, TypeError):
+            return
+        with lock:
+            arrivals.append((frame, arrived))
+
+    try:
+        subscription = Subscription(config, lambda keys: keys.yaw, on_sample)
+    except Exception as exc:  # reported to the parent, which raises
+        connection.send(f"{type(exc).__name__}: {exc}")
+        return
+    with subscription:
+        connection.send(True)
+        while True:
+            try:
+                command = connection.recv()
+            except (EOFError, OSError):
+                return
+            if command[0] == "publisher":
+                connection.send(subscription.wait_for_publisher(command[1]))
+            elif command[0] == "count":
+                with lock:
+                    connection.send(len(arrivals))
+            elif command[0] == "arrivals":
+                with lock:
+                    connection.send(list(arrivals))
+            else:
+                return
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,7 +203,7 @@ def measure_latency(
 
     port = free_local_port()
     publishing = demo_config(config, port)
-    stamps = CaptureStamps(received_s)
+    stamps = CaptureStamps(received_s, capacity=MAX_SAMPLES)
     with bus_outputs(publishing, source_label, publish=True) as bus:
         probe = YawLatencyProbe(subscriber_config(publishing, port), stamps)
         try:

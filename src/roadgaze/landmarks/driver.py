@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import Protocol
 
 import numpy as np
 
@@ -16,14 +17,24 @@ DRIVER_MATCH_IOU = 0.3
 """Box overlap above which a face in a new frame is taken to be the previous frame's driver."""
 
 
-def _area(face: FaceFeatures) -> float:
+Box = tuple[float, float, float, float]
+
+
+class Boxed(Protocol):
+    """A face with its bounding box: `FaceFeatures`, or a face found but not yet measured."""
+
+    @property
+    def box_px(self) -> Box: ...
+
+
+def _area(face: Boxed) -> float:
     return (face.box_px[2] - face.box_px[0]) * (face.box_px[3] - face.box_px[1])
 
 
 def choose_driver(
-    faces: Sequence[FaceFeatures],
+    faces: Sequence[Boxed],
     rule: str,
-    previous_box_px: tuple[float, float, float, float] | None = None,
+    previous_box_px: Box | None = None,
 ) -> int | None:
     """Index of the driver among `faces` under `rule`, None when there is no face.
 
@@ -56,7 +67,7 @@ def choose_driver(
     raise ValueError(f"unknown driver rule '{rule}'; choose largest, left or right")
 
 
-def box_iou(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> float:
+def box_iou(a: Box, b: Box) -> float:
     width = min(a[2], b[2]) - max(a[0], b[0])
     height = min(a[3], b[3]) - max(a[1], b[1])
     if width <= 0 or height <= 0:

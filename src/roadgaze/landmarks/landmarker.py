@@ -1,7 +1,11 @@
 """MediaPipe FaceLandmarker as a `LandmarkDetector`: IMAGE mode for stills, VIDEO mode for streams.
 
 It measures every face with `features_from_landmarks` and chooses the driver among several faces
-by `LandmarksConfig.driver` (see `roadgaze.landmarks.driver`).
+by `LandmarksConfig.driver` (see `roadgaze.landmarks.driver`). The work of one frame comes in three
+steps so that a stream can run them on three threads (`roadgaze.pipeline`): `prepare` (the image
+for MediaPipe; no state), `infer` (MediaPipe itself, the frames in order; in VIDEO mode also the
+driver's choice, which the next frame's tracking needs) and `measure` (the features of each face;
+no state). `detect` is the three in a row.
 """
 
 from __future__ import annotations
@@ -18,15 +22,21 @@ from roadgaze.config import Config, LandmarksConfig
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored
 from roadgaze.landmarks.eye_contrast import eye_contrast
 from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
-from roadgaze.landmarks.features import DEFAULT_CHOICE, LandmarkChoice, features_from_landmarks
+from roadgaze.landmarks.features import (
+    DEFAULT_CHOICE,
+    NUM_LANDMARKS,
+    LandmarkChoice,
+    features_from_landmarks,
+)
 from roadgaze.landmarks.multi_face import (
+    BackgroundCount,
     FaceCounter,
     FaceMode,
     MultiFaceSwitch,
     detector_model_bytes,
 )
 from roadgaze.landmarks.native_log import filtered_native_stderr
-from roadgaze.landmarks.results import run_landmarker
+from roadgaze.landmarks.results import Blendshapes, run_landmarker
 from roadgaze.types import ClosesOnExit, Detection, FaceFeatures
 
 
@@ -66,6 +76,39 @@ class PreparedImage:
     rgb: npt.NDArray[np.uint8]
     mp_image: Any
     """The `mediapipe.Image` (MediaPipe's own copy of `rgb`)."""
+    gray: npt.NDArray[np.uint8]
+    """The grey image the eye check measures."""
+
+
+Box = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class FoundFace:
+    """One face as MediaPipe found it, before roadgaze measures it."""
+
+    landmarks_px: npt.NDArray[np.float32]
+    """(478, 3) landmarks: x, y in pixels, z in the scale of x; all finite."""
+    matrix: npt.NDArray[np.float64] | None
+    """MediaPipe's 4x4 facial transformation matrix."""
+    blendshapes: Blendshapes | None
+    box_px: Box
+    """(x_min, y_min, x_max, y_max) of the landmarks, pixels (what `FaceFeatures.box_px` holds)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Inference:
+    """What MediaPipe found in one frame (`MediaPipeLandmarker.infer`), for `measure`."""
+
+    rgb: npt.NDArray[np.uint8]
+    """The image the faces were found in."""
+    gray: npt.NDArray[np.uint8]
+    """`rgb` in grey, for the eye check."""
+    faces: tuple[FoundFace, ...]
+    driver_index: int | None
+    """VIDEO mode: the driver among `faces` (None: no face). IMAGE mode: None, `measure` chooses."""
+    mirrored: tuple[FoundFace, ...] = ()
+    """`mirror_average`: the faces found in the horizontally flipped image."""
 
 
 class MediaPipeLandmarker(ClosesOnExit):
@@ -97,11 +140,12 @@ class MediaPipeLandmarker(ClosesOnExit):
         self._choice = choice
         self._last_ms = -1
         self._last_t_s = -math.inf
-        self._driver_box_px: tuple[float, float, float, float] | None = None
+        self._driver_box_px: Box | None = None
         self._landmarker: Any = None
         self._mirror_landmarker: Any = None
         self._single_landmarker: Any = None
         self._counter: FaceCounter | None = None
+        self._background: BackgroundCount | None = None
         self._switch: MultiFaceSwitch | None = None
         self._started: set[int] = set()
         """Landmarkers (by id) that have run once."""
@@ -122,6 +166,7 @@ class MediaPipeLandmarker(ClosesOnExit):
                     self._counter = FaceCounter(
                         detector_model, landmarks_config.min_detection_confidence
                     )
+                    self._background = BackgroundCount(self._counter)
                     self._switch = MultiFaceSwitch(landmarks_config.multi_face_check_s)
         except (RuntimeError, ValueError, OSError) as exc:
             self.close()
@@ -167,7 +212,8 @@ class MediaPipeLandmarker(ClosesOnExit):
         (the loop's decode thread does). Raises ValueError for an image that is not uint8 2-D/3-D.
         """
         rgb = to_rgb(image)
-        return PreparedImage(rgb, self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb))
+        mp_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb)
+        return PreparedImage(rgb, mp_image, rgb_to_gray(rgb))
 
     def detect(self, image: npt.NDArray[np.uint8], t_s: float | None = None) -> Detection:
         """All faces in one BGR (or grayscale / BGRA) uint8 image and which one is the driver.
@@ -177,10 +223,18 @@ class MediaPipeLandmarker(ClosesOnExit):
         """
         if self._landmarker is None:
             raise ValueError("landmarker is closed")
-        return self.detect_prepared(self.prepare(image), t_s)
+        return self.measure(self.infer(self.prepare(image), t_s))
 
     def detect_prepared(self, prepared: PreparedImage, t_s: float | None = None) -> Detection:
         """`detect` of an image `prepare` made; the same errors but the image's."""
+        return self.measure(self.infer(prepared, t_s))
+
+    def infer(self, prepared: PreparedImage, t_s: float | None = None) -> Inference:
+        """MediaPipe on an image `prepare` made: the faces in pixels and, in VIDEO mode, the driver.
+
+        Calls must come in frame order (one thread at a time); the errors are `detect`'s but the
+        image's.
+        """
         if self._landmarker is None:
             raise ValueError("landmarker is closed")
         rgb, mp_image = prepared.rgb, prepared.mp_image
@@ -197,86 +251,118 @@ class MediaPipeLandmarker(ClosesOnExit):
             self._last_t_s, self._last_ms = t_s, timestamp_ms
         elif t_s is not None:
             raise ValueError("IMAGE mode takes no timestamp; construct with video=True")
+        size = (rgb.shape[1], rgb.shape[0])
         if self._switch is not None and t_s is not None:
-            faces = self._run_switching(mp_image, rgb, t_s, timestamp_ms)
+            faces = self._run_switching(mp_image, size, t_s, timestamp_ms)
         else:
-            faces = self._run(self._landmarker, mp_image, rgb, timestamp_ms)
+            faces = self._find(self._landmarker, mp_image, size, timestamp_ms)
+        mirrored: list[FoundFace] = []
         if self._mirror_landmarker is not None:
-            flipped = np.ascontiguousarray(rgb[:, ::-1])
-            mirrored_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=flipped)
-            mirrored = self._run(self._mirror_landmarker, mirrored_image, flipped, timestamp_ms)
-            faces = merge_mirrored(faces, mirrored, rgb.shape[1])
+            flipped = self._mp.Image(
+                image_format=self._mp.ImageFormat.SRGB, data=np.ascontiguousarray(rgb[:, ::-1])
+            )
+            mirrored = self._find(self._mirror_landmarker, flipped, size, timestamp_ms)
         if not self._video:
-            return Detection(tuple(faces), choose_driver(faces, self._config.driver))
+            return Inference(rgb, prepared.gray, tuple(faces), None, tuple(mirrored))
+        # Chosen on the faces of the original image (with `mirror_average` their merged
+        # measurements keep these indices).
         driver_index = choose_driver(faces, self._config.driver, self._driver_box_px)
         self._driver_box_px = None if driver_index is None else faces[driver_index].box_px
         if self._switch is not None and self._switch.mode is FaceMode.MULTI:
             self._switch.seen(t_s or 0.0, len(faces), self._driver_box_px)
-        return Detection(faces=tuple(faces), driver_index=driver_index)
+        return Inference(rgb, prepared.gray, tuple(faces), driver_index, tuple(mirrored))
+
+    def measure(self, inference: Inference) -> Detection:
+        """The features of each face `infer` found (roll removed, eyes, quality) and the driver.
+
+        Keeps no state, so it may run on another thread while `infer` works on the next frame.
+        """
+        rgb = inference.rgb
+        faces = self._features(inference.faces, inference.gray)
+        if self._mirror_landmarker is not None:
+            flipped_gray = np.ascontiguousarray(inference.gray[:, ::-1])
+            mirrored = self._features(inference.mirrored, flipped_gray)
+            faces = merge_mirrored(faces, mirrored, rgb.shape[1])
+        if not self._video:
+            return Detection(tuple(faces), choose_driver(faces, self._config.driver))
+        return Detection(faces=tuple(faces), driver_index=inference.driver_index)
 
     def _run_switching(
-        self, mp_image: Any, rgb: npt.NDArray[np.uint8], t_s: float, timestamp_ms: int | None
-    ) -> list[FaceFeatures]:
+        self, mp_image: Any, size: tuple[int, int], t_s: float, timestamp_ms: int | None
+    ) -> list[FoundFace]:
         """One frame of a stream: the one-face landmarker unless a count sees several faces."""
-        switch, counter = self._switch, self._counter
-        assert switch is not None and counter is not None
+        switch, counter, background = self._switch, self._counter, self._background
+        assert switch is not None and counter is not None and background is not None
+        finished = background.finished()
+        if finished is not None:
+            switch.counted(*finished)
         if switch.check_due(t_s):
-            switch.counted(t_s, counter.count(mp_image))
+            if switch.next_check_t_s is None:  # the first frame: counted before it is tracked
+                switch.counted(t_s, counter.count(mp_image))
+            else:  # the periodic count, taken a frame or two later (the check period is 1 s)
+                background.start(t_s, mp_image)
         if switch.mode is FaceMode.SINGLE:
-            faces = self._run(self._single_landmarker, mp_image, rgb, timestamp_ms)
+            faces = self._find(self._single_landmarker, mp_image, size, timestamp_ms)
             if not faces and switch.previous_box is not None:
                 # Tracking was lost on this frame. MediaPipe would look for a face only on the
                 # next one; look again now (its detector runs once it tracks no face), as the
                 # multi-face landmarker, which detects on every frame, would have.
-                faces = self._run(self._single_landmarker, mp_image, rgb, self._next_ms())
+                faces = self._find(self._single_landmarker, mp_image, size, self._next_ms())
             box = faces[0].box_px if faces else None
             if not switch.jumped(t_s, box):
                 return faces
             switch.counted(t_s, counter.count(mp_image))
             if not switch.multi:
                 return faces
-            return self._run(self._landmarker, mp_image, rgb, self._next_ms())
-        return self._run(self._landmarker, mp_image, rgb, timestamp_ms)
+            return self._find(self._landmarker, mp_image, size, self._next_ms())
+        return self._find(self._landmarker, mp_image, size, timestamp_ms)
 
     def _next_ms(self) -> int:
         """A further MediaPipe timestamp within the current frame (a second call on it)."""
         self._last_ms += 1
         return self._last_ms
 
-    def _run(
-        self,
-        landmarker: Any,
-        mp_image: Any,
-        rgb: npt.NDArray[np.uint8],
-        timestamp_ms: int | None,
-    ) -> list[FaceFeatures]:
-        """The faces of one run, each with its blendshapes and the contrast of its eye openings
-        (measured on `rgb`, the image `mp_image` holds)."""
-        height, width = rgb.shape[:2]
-        scale = np.array([width, height, width], np.float32)
+    def _find(
+        self, landmarker: Any, mp_image: Any, size: tuple[int, int], timestamp_ms: int | None
+    ) -> list[FoundFace]:
+        """The faces of one run of `landmarker` on the `mediapipe.Image` `mp_image` of `size`
+        (width, height) pixels; a face with other than 478 landmarks or a non-finite one is
+        dropped (`features_from_landmarks` could not measure it)."""
+        scale = np.array([size[0], size[1], size[0]], np.float32)
         if id(landmarker) in self._started:
             results = run_landmarker(landmarker, mp_image, timestamp_ms)
         else:  # MediaPipe's first inference logs its set-up (tensor alignment) on fd 2
             with filtered_native_stderr():
                 results = run_landmarker(landmarker, mp_image, timestamp_ms)
             self._started.add(id(landmarker))
-        faces: list[FaceFeatures] = []
-        gray: npt.NDArray[np.uint8] | None = None
+        faces: list[FoundFace] = []
         for points, matrix, blendshapes in results:
             pixels = points * scale
-            try:
-                features = features_from_landmarks(pixels, (width, height), matrix, self._choice)
-            except ValueError:
+            if pixels.shape != (NUM_LANDMARKS, 3) or not np.isfinite(pixels).all():
                 continue
-            if gray is None:
-                gray = rgb_to_gray(rgb)
+            low, high = pixels[:, :2].min(axis=0), pixels[:, :2].max(axis=0)
+            box = (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
+            faces.append(FoundFace(pixels, matrix, blendshapes, box))
+        return faces
+
+    def _features(
+        self, found: tuple[FoundFace, ...], gray: npt.NDArray[np.uint8]
+    ) -> list[FaceFeatures]:
+        """Each face measured, with its blendshapes and the contrast of its eye openings (on
+        `gray`, the image it was found in)."""
+        size = (gray.shape[1], gray.shape[0])
+        faces: list[FaceFeatures] = []
+        for face in found:
+            pixels = face.landmarks_px
+            features = features_from_landmarks(pixels, size, face.matrix, self._choice)
             contrast = (eye_contrast(gray, pixels, RIGHT_EYE), eye_contrast(gray, pixels, LEFT_EYE))
-            faces.append(replace(features, blendshapes=blendshapes, eye_contrast=contrast))
+            faces.append(replace(features, blendshapes=face.blendshapes, eye_contrast=contrast))
         return faces
 
     def close(self) -> None:
         with filtered_native_stderr():
-            for name in ("_landmarker", "_mirror_landmarker", "_single_landmarker", "_counter"):
+            names = ("_background", "_landmarker", "_mirror_landmarker", "_single_landmarker")
+            for name in (*names, "_counter"):
                 resource = getattr(self, name, None)
                 if resource is not None:
                     resource.close()

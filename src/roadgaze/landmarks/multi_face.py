@@ -9,12 +9,16 @@ seconds, and whenever the tracked face jumps or comes back after a loss. Only wh
 two or more faces does the stream switch to the `max_faces` landmarker, where the driver rule
 (`landmarks.driver`) chooses; after `MULTI_FACE_RETURN_S` with at most one face it returns to the
 one-face landmarker. `MultiFaceSwitch` is that decision, pure and testable without MediaPipe.
+The periodic counts run on a thread of their own (`BackgroundCount`) and take effect a frame or
+two later, so the stream's landmark thread does not wait for them; the first frame's count and
+a count after a jump are made at once, because they decide that very frame.
 """
 
 from __future__ import annotations
 
 import logging
 import zipfile
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -140,3 +144,34 @@ class FaceCounter:
         if self._detector is not None:
             self._detector.close()
             self._detector = None
+
+
+class BackgroundCount:
+    """One face count at a time on a thread of its own: `start` it, take it when `finished`."""
+
+    def __init__(self, counter: FaceCounter) -> None:
+        self._counter = counter
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="roadgaze-facecount")
+        self._pending: tuple[float, Future[int]] | None = None
+
+    @property
+    def pending(self) -> bool:
+        return self._pending is not None
+
+    def start(self, t_s: float, image: Any) -> None:
+        """Count the faces in the `mediapipe.Image` `image` of the frame at `t_s`."""
+        if self._pending is None:
+            self._pending = (t_s, self._pool.submit(self._counter.count, image))
+
+    def finished(self) -> tuple[float, int] | None:
+        """(t_s, faces) of the count once it is done (then no count is pending), else None.
+        Raises what the count raised."""
+        if self._pending is None or not self._pending[1].done():
+            return None
+        t_s, future = self._pending
+        self._pending = None
+        return t_s, future.result()
+
+    def close(self) -> None:
+        """Wait for a pending count; the counter itself is closed by its owner."""
+        self._pool.shutdown(wait=True)

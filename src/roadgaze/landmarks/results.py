@@ -7,6 +7,13 @@ an array (another 0.9 ms). Where MediaPipe's Python package talks to its C libra
 `detect`/`detect_for_video` calls and reads the landmark array straight out of the C result
 (0.05 ms); with any other MediaPipe it uses the public API and one vectorised conversion. Both give
 identical numbers (tested).
+
+MediaPipe >= 1.0 runs each C call of a landmarker on a thread of its own (`SerialDispatcher`, so
+that one landmarker is never called from two threads at once): two thread hand-overs per call.
+roadgaze calls a landmarker from one thread at a time (the loop's landmark thread), so it calls
+the C function the dispatcher wraps on that thread, with the same arguments and MediaPipe's own
+status check (`_raw_library`); the hand-overs cost 0.1-0.5 ms per frame, more while the other
+core is busy.
 """
 
 from __future__ import annotations
@@ -62,7 +69,7 @@ class _CResultReader:
     def read(self, result: Any) -> list[FaceArrays]:
         faces: list[FaceArrays] = []
         matrices = [
-            result.facial_transformation_matrixes[i].to_numpy()
+            _matrix(result.facial_transformation_matrixes[i])
             for i in range(result.facial_transformation_matrixes_count)
         ]
         blendshapes = [
@@ -75,12 +82,28 @@ class _CResultReader:
             if count == 0:
                 faces.append((np.empty((0, 3), np.float32), None, scores))
                 continue
-            pointer = ctypes.cast(face.landmarks, ctypes.POINTER(ctypes.c_float))
-            flat = np.ctypeslib.as_array(pointer, shape=(count * self.floats_per_landmark,))
-            points = flat.reshape(count, self.floats_per_landmark)[:, :3].copy()
-            matrix = np.asarray(matrices[i], np.float64) if i < len(matrices) else None
+            stride = self.floats_per_landmark
+            flat = _floats(face.landmarks, count * stride)
+            points = flat.reshape(count, stride)[:, :3].copy()
+            matrix = matrices[i] if i < len(matrices) else None
             faces.append((points, matrix, scores))
         return faces
+
+
+def _floats(pointer: Any, count: int) -> npt.NDArray[np.float32]:
+    """A copy of `count` C floats at `pointer` (one memory copy; `np.ctypeslib.as_array` builds
+    a ctypes array type first, several times slower)."""
+    address = ctypes.cast(pointer, ctypes.c_void_p).value
+    return np.frombuffer(ctypes.string_at(address or 0, 4 * count), dtype=np.float32)
+
+
+def _matrix(matrix: Any) -> npt.NDArray[np.float64] | None:
+    """MediaPipe's `MpMatrixC` (column-major floats) as a row-major float64 array, as its own
+    `to_numpy` reads it; None when empty."""
+    rows, cols = int(matrix.rows), int(matrix.cols)
+    if not matrix.data or rows == 0 or cols == 0:
+        return None
+    return np.asarray(_floats(matrix.data, rows * cols).reshape(cols, rows).T, np.float64)
 
 
 def _scores(categories: Any) -> Blendshapes:
@@ -98,6 +121,25 @@ def _scores(categories: Any) -> Blendshapes:
 def _reader() -> _CResultReader | None:
     """Found on first use: importing MediaPipe waits until a landmarker runs."""
     return _CResultReader.find()
+
+
+@functools.cache
+def _status_check() -> Any:
+    """MediaPipe's `handle_status(status, error_message)`; None where it is not found."""
+    try:
+        utils = importlib.import_module("mediapipe.tasks.python.core.mediapipe_c_utils")
+    except ImportError:
+        return None
+    return getattr(utils, "handle_status", None)
+
+
+def _raw_library(landmarker: Any) -> Any | None:
+    """The `ctypes.CDLL` behind the landmarker's `SerialDispatcher`, None where there is none."""
+    raw = getattr(getattr(landmarker, "_lib", None), "_lib", None)
+    needed = ("MpFaceLandmarkerDetectForVideo", "MpFaceLandmarkerDetectImage", "MpErrorFree")
+    if not isinstance(raw, ctypes.CDLL) or _status_check() is None:
+        return None
+    return raw if all(hasattr(raw, name) for name in needed) else None
 
 
 def uses_c_results(landmarker: Any) -> bool:
@@ -145,18 +187,28 @@ def run_landmarker(
 def _run_direct(
     landmarker: Any, image: Any, timestamp_ms: int | None, reader: _CResultReader
 ) -> list[FaceArrays]:
-    """What `detect`/`detect_for_video` do, minus the per-landmark Python objects."""
+    """What `detect`/`detect_for_video` do, minus the per-landmark Python objects (and, where
+    MediaPipe dispatches its C calls to a thread of its own, minus the hand-overs)."""
     lib = landmarker._lib
+    raw = _raw_library(landmarker)
     result = reader.result_type()
-    if timestamp_ms is None:
-        lib.MpFaceLandmarkerDetectImage(
-            landmarker._handle, image._image_ptr, None, ctypes.byref(result)
-        )
+    args: tuple[Any, ...] = (landmarker._handle, image._image_ptr, None)
+    if timestamp_ms is not None:
+        args += (timestamp_ms,)
+    name = (
+        "MpFaceLandmarkerDetectImage" if timestamp_ms is None else "MpFaceLandmarkerDetectForVideo"
+    )
+    if raw is None:
+        getattr(lib, name)(*args, ctypes.byref(result))
     else:
-        lib.MpFaceLandmarkerDetectForVideo(
-            landmarker._handle, image._image_ptr, None, timestamp_ms, ctypes.byref(result)
-        )
+        error = ctypes.c_char_p()
+        status = getattr(raw, name)(*args, ctypes.byref(result), ctypes.byref(error))
+        try:
+            _status_check()(status, error)
+        finally:
+            if error.value is not None:
+                raw.MpErrorFree(error)
     try:
         return reader.read(result)
     finally:
-        lib.MpFaceLandmarkerCloseResult(ctypes.byref(result))
+        (lib if raw is None else raw).MpFaceLandmarkerCloseResult(ctypes.byref(result))

@@ -1,4 +1,4 @@
-"""A step of the loop in its own thread: order, bounds, errors and stopping (`roadgaze.handoff`)."""
+"""A step of the loop in its own thread: order, bounds, errors, stopping (`pipeline.handoff`)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from collections.abc import Iterator
 import pytest
 
 from roadgaze.errors import SourceError
-from roadgaze.handoff import Handoff
+from roadgaze.pipeline.handoff import Handoff
 
 
 def counting(produced: list[int], count: int) -> Iterator[int]:

@@ -1,8 +1,8 @@
 """One step of the loop in its own thread, handing its results over through a bounded queue.
 
-The loop decodes a file (and prepares each image for MediaPipe) this way while MediaPipe works on
-the frame before (`roadgaze.pipeline`). The queue holds at most `depth` items, so a step runs at
-most `depth` + 1 items ahead and memory stays flat.
+The loop decodes a file (and prepares each image for MediaPipe) this way, and runs MediaPipe this
+way while its own thread finishes the frame before (`roadgaze.pipeline.steps`). The queue holds at
+most `depth` items, so a step runs at most `depth` + 1 items ahead and memory stays flat.
 """
 
 from __future__ import annotations

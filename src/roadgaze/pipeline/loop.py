@@ -18,23 +18,29 @@ from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
-import numpy as np
-import numpy.typing as npt
-
-from roadgaze.capture import FrameSource, SourceStatus
+from roadgaze.capture import FrameSource
 from roadgaze.config import Config, EyesConfig
-from roadgaze.handoff import Handoff
 from roadgaze.landmarks.eyes import driver_eyes
 from roadgaze.monitor import Monitor
+from roadgaze.pipeline.handoff import Handoff
+from roadgaze.pipeline.runtime import Collector, loop_runtime
+from roadgaze.pipeline.steps import (
+    Decoded,
+    DetectorSteps,
+    Inferred,
+    Pacer,
+    decode_frames,
+    infer_frames,
+)
+from roadgaze.pipeline.timing import RunSummary, StageTimes, StageTimings
 from roadgaze.pose import PoseEstimator
-from roadgaze.types import Detection, Frame, FrameRecord, LandmarkDetector
-
-STAGES = ("decode", "landmarks", "geometry", "smoothing", "monitor", "sinks", "total")
-"""Timed stages; `total` is one whole loop iteration, from asking for the frame to the last sink."""
+from roadgaze.types import Frame, FrameRecord, LandmarkDetector
 
 READ_AHEAD_FRAMES = 2
 """Frames a file source is decoded (and prepared) ahead of the loop: enough to hide decoding, few
 enough to keep memory flat."""
+INFER_AHEAD_FRAMES = 1
+"""Frames the landmark thread may hand over before the loop takes them (it runs one more)."""
 STOP_GRACE_S = 1.0
 """After a stop is asked for, how long the frame in hand may take before a live source is closed
 (which unblocks a loop waiting for a lost camera)."""
@@ -63,24 +69,6 @@ class Sink(Protocol):
 
 
 @dataclass(frozen=True, slots=True)
-class StageTimes:
-    """Milliseconds spent on one frame per stage."""
-
-    decode_ms: float
-    """Getting the frame from the source (decoding a file; waiting for a camera frame)."""
-    landmarks_ms: float
-    geometry_ms: float
-    smoothing_ms: float
-    monitor_ms: float
-    sinks_ms: float
-    total_ms: float
-
-    def as_tuple(self) -> tuple[float, ...]:
-        """The times in `STAGES` order."""
-        return tuple(getattr(self, name) for name in self.__slots__)
-
-
-@dataclass(frozen=True, slots=True)
 class ProcessedFrame:
     """One frame, its record and how long each stage took."""
 
@@ -88,107 +76,6 @@ class ProcessedFrame:
     record: FrameRecord
     times: StageTimes
     """Before the sinks ran, `sinks_ms` is 0 and `total_ms` ends after the monitor."""
-
-
-@dataclass(frozen=True, slots=True)
-class _Decoded:
-    """A frame from the source, with its image prepared for the detector when it could be."""
-
-    frame: Frame
-    prepared: Any = None
-    """What the detector's `prepare(image)` made of the image (None: not prepared)."""
-
-
-def _decoded(
-    source: FrameSource, prepare: Callable[[Any], Any] | None, spent: deque[Any]
-) -> Iterator[_Decoded]:
-    """The decode thread's part: each frame and its prepared image. Prepared images come back
-    through `spent` to be released here, off the loop's thread (a `mediapipe.Image`: 0.25 ms)."""
-    for frame in source:
-        while spent:
-            spent.popleft()
-        yield _Decoded(frame, None if prepare is None else prepare(frame.image))
-
-
-@dataclass(frozen=True, slots=True)
-class _Detected:
-    """A frame after the landmark stage, on its way to the rest of the loop."""
-
-    frame: Frame
-    detection: Detection
-    decode_ms: float
-    landmarks_ms: float
-    received_s: float
-    """When the loop received the frame from its source (its `clock`, after pacing)."""
-
-
-@dataclass(frozen=True, slots=True)
-class StageStats:
-    median_ms: float
-    p99_ms: float
-
-
-class StageTimings:
-    """Per-stage times of the most recent `capacity` frames (a fixed ring: memory stays flat).
-
-    The first `skip_first` frames (model start-up) are not recorded.
-    """
-
-    def __init__(self, capacity: int = 20_000, skip_first: int = 0) -> None:
-        self._times_ms: npt.NDArray[np.float64] = np.zeros((capacity, len(STAGES)))
-        self._count = 0
-        self._to_skip = skip_first
-
-    def skip_next(self, frames: int) -> None:
-        """Do not record the next `frames` frames (the start-up of another pass)."""
-        self._to_skip = frames
-
-    def add(self, times: StageTimes) -> None:
-        if self._to_skip > 0:
-            self._to_skip -= 1
-            return
-        self._times_ms[self._count % len(self._times_ms)] = times.as_tuple()
-        self._count += 1
-
-    @property
-    def count(self) -> int:
-        """Frames recorded in total, skipped ones excluded (may exceed what the ring holds)."""
-        return self._count
-
-    def stats(self) -> dict[str, StageStats]:
-        """Median and 99th percentile per stage over the frames held; empty without frames."""
-        held = self._times_ms[: min(self._count, len(self._times_ms))]
-        if len(held) == 0:
-            return {}
-        medians = np.median(held, axis=0)
-        p99s = np.percentile(held, 99, axis=0)
-        return {
-            stage: StageStats(median_ms=float(medians[i]), p99_ms=float(p99s[i]))
-            for i, stage in enumerate(STAGES)
-        }
-
-
-@dataclass(frozen=True, slots=True)
-class RunSummary:
-    """What one run of the loop did."""
-
-    frames: int
-    frames_with_face: int
-    wall_s: float
-    source_status: SourceStatus
-    stages: dict[str, StageStats]
-
-    @property
-    def fps(self) -> float:
-        return self.frames / self.wall_s if self.wall_s > 0 else 0.0
-
-    @property
-    def overhead_ratio(self) -> float:
-        """Median total frame time over median landmark time (1.0: the loop costs nothing)."""
-        total, landmarks = self.stages.get("total"), self.stages.get("landmarks")
-        if total is None or landmarks is None or landmarks.median_ms <= 0:
-            return math.nan
-        return total.median_ms / landmarks.median_ms
 
 
 class Pipeline:
@@ -209,6 +96,7 @@ class Pipeline:
         self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
         self.speed = speed
         self._clock = clock
+        self._steps = DetectorSteps.of(detector)
         self._frame_received_s = math.nan
 
     @classmethod
@@ -225,31 +113,26 @@ class Pipeline:
 
     @property
     def frame_received_s(self) -> float:
-        """When the loop received the frame in hand from its source (the `clock`, seconds; after
-        pacing); sinks read it during `on_record`, e.g. to measure latency. NaN before a frame."""
+        """When the frame in hand was received from its source (the `clock`, seconds; after
+        pacing; in the landmark thread); sinks read it during `on_record`, e.g. to measure
+        latency. NaN before a frame."""
         return self._frame_received_s
 
     def process(self, frame: Frame, decode_ms: float = 0.0) -> ProcessedFrame:
-        """One frame through every stage; frames must come in time order."""
-        return self._finish(self._detect(_Decoded(frame), decode_ms, self._clock()))
+        """One frame through every stage on this thread; frames must come in time order."""
+        received_s = self._clock()
+        inference = self._steps.infer(self._steps.input_of(frame, None), frame.t_s)
+        inferred_s = self._clock()
+        infer_ms = (inferred_s - received_s) * 1e3
+        return self._finish(Inferred(frame, inference, decode_ms, infer_ms, received_s, inferred_s))
 
-    def _detect(self, decoded: _Decoded, decode_ms: float, received_s: float) -> _Detected:
-        """The landmark stage of one frame (with the image prepared beforehand when it was)."""
-        frame = decoded.frame
-        start = self._clock()
-        detect_prepared = getattr(self.detector, "detect_prepared", None)
-        if decoded.prepared is not None and detect_prepared is not None:
-            detection: Detection = detect_prepared(decoded.prepared, frame.t_s)
-        else:
-            detection = self.detector.detect(frame.image, frame.t_s)
-        landmarks_ms = (self._clock() - start) * 1e3
-        return _Detected(frame, detection, decode_ms, landmarks_ms, received_s)
-
-    def _finish(self, detected: _Detected) -> ProcessedFrame:
-        """Pose, smoothing and monitor for a frame whose landmarks are known."""
+    def _finish(self, inferred: Inferred) -> ProcessedFrame:
+        """The faces measured, then pose, smoothing and monitor, for a frame after `infer`."""
         clock = self._clock
-        frame, detection = detected.frame, detected.detection
+        frame = inferred.frame
         start = clock()
+        detection = self._steps.measure(inferred.inference)
+        after_measure = clock()
         driver = detection.driver
         yaw_raw_deg = self.pose.raw_yaw_deg(driver)
         # The matrix pitch's down gain starts at the monitor's current neutral pitch.
@@ -263,13 +146,14 @@ class Pipeline:
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)
         after_monitor = clock()
         times = StageTimes(
-            decode_ms=detected.decode_ms,
-            landmarks_ms=detected.landmarks_ms,
-            geometry_ms=(after_geometry - start) * 1e3,
+            decode_ms=inferred.decode_ms,
+            landmarks_ms=inferred.infer_ms + (after_measure - start) * 1e3,
+            handover_ms=(start - inferred.inferred_s) * 1e3,
+            geometry_ms=(after_geometry - after_measure) * 1e3,
             smoothing_ms=(after_smoothing - after_geometry) * 1e3,
             monitor_ms=(after_monitor - after_smoothing) * 1e3,
             sinks_ms=0.0,
-            total_ms=detected.decode_ms + detected.landmarks_ms + (after_monitor - start) * 1e3,
+            total_ms=inferred.decode_ms + (after_monitor - inferred.received_s) * 1e3,
         )
         return ProcessedFrame(frame=frame, record=record, times=times)
 
@@ -284,47 +168,40 @@ class Pipeline:
         """The loop as an iterator. `realtime` paces a file source at its own timeline; `stop`
         ends the loop before the next frame.
 
-        A file is decoded, and each image prepared for the detector (`prepare`), in a thread of its
-        own `READ_AHEAD_FRAMES` ahead while the detector works; a camera grabs in its own thread.
-        The rest runs on the caller's thread with no hand-over, so a frame's latency is its own.
+        A file is decoded, and each image prepared for the detector, in a thread of its own
+        `READ_AHEAD_FRAMES` ahead; a camera grabs in its own thread. MediaPipe runs in the
+        landmark thread (`roadgaze.pipeline.steps`), handing each frame over as soon as it is
+        done; the rest runs on the caller's thread while MediaPipe works on the next frame.
         """
-        clock = self._clock
-        pace = realtime and not source.info.live
-        first_t_s: float | None = None
-        wall_start = 0.0
-        produced = 0
         spent: deque[Any] = deque(maxlen=2 * READ_AHEAD_FRAMES + 2)
+        produced = 0
         with contextlib.ExitStack() as stack:
-            items: Iterator[_Decoded]
+            stack.enter_context(loop_runtime())
+            collector = Collector()
+            items: Iterator[Decoded]
             if source.info.live:
-                items = (_Decoded(frame) for frame in source)
+                items = (Decoded(frame) for frame in source)
             else:
-                prepare = getattr(self.detector, "prepare", None)
-                decoding = Handoff(
-                    _decoded(source, prepare, spent), "roadgaze-decode", READ_AHEAD_FRAMES
-                )
+                decoded = decode_frames(source, self._steps.prepare, spent)
+                decoding = Handoff(decoded, "roadgaze-decode", READ_AHEAD_FRAMES)
                 items = iter(stack.enter_context(decoding))
+            pacer = Pacer(self._clock) if realtime and not source.info.live else None
+            inferring = Handoff(
+                infer_frames(items, self._steps, self._clock, pacer, spent),
+                "roadgaze-landmarks",
+                INFER_AHEAD_FRAMES,
+            )
+            inferred = iter(stack.enter_context(inferring))
             while max_frames is None or produced < max_frames:
                 if stop is not None and stop.is_set():
                     return
-                before = clock()
-                item = next(items, None)
-                decode_ms = (clock() - before) * 1e3
+                item = next(inferred, None)
                 if item is None:
                     return
-                if pace:
-                    if first_t_s is None:
-                        first_t_s, wall_start = item.frame.t_s, clock()
-                    wait_s = wall_start + (item.frame.t_s - first_t_s) - clock()
-                    if wait_s > 0:
-                        time.sleep(wait_s)
-                self._frame_received_s = clock()
-                detected = self._detect(item, decode_ms, self._frame_received_s)
-                if item.prepared is not None:
-                    spent.append(item.prepared)
-                del item  # the decode thread releases the prepared image
-                yield self._finish(detected)
+                self._frame_received_s = item.received_s
+                yield self._finish(item)
                 produced += 1
+                collector.after_frame()  # after the frame's sinks: off its latency
 
     def run(
         self,
@@ -360,15 +237,7 @@ class Pipeline:
                     sinks_ms = (clock() - before_sinks) * 1e3
                     times = processed.times
                     timings.add(
-                        StageTimes(
-                            decode_ms=times.decode_ms,
-                            landmarks_ms=times.landmarks_ms,
-                            geometry_ms=times.geometry_ms,
-                            smoothing_ms=times.smoothing_ms,
-                            monitor_ms=times.monitor_ms,
-                            sinks_ms=sinks_ms,
-                            total_ms=times.total_ms + sinks_ms,
-                        )
+                        replace(times, sinks_ms=sinks_ms, total_ms=times.total_ms + sinks_ms)
                     )
                     frames += 1
                     with_face += processed.record.sample.face

@@ -1,0 +1,161 @@
+"""The loop's two threads ahead of it: decoding a file, and the landmark inference.
+
+Per frame the decode thread reads the frame and prepares its image for the detector
+(`decode_frames`), the landmark thread runs MediaPipe on it (`infer_frames`), and the loop's own
+thread measures the faces, estimates the pose, runs the monitor and feeds the sinks. MediaPipe
+releases Python's lock while it works, so on a second core everything else overlaps with the
+inference of the next frame and the loop runs at MediaPipe's own rate.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from roadgaze.capture import FrameSource
+from roadgaze.types import Detection, Frame, LandmarkDetector
+
+log = logging.getLogger(__name__)
+
+DECODE_NICENESS = 10
+"""How much lower than the rest of the loop the decode thread runs (Linux thread niceness). It
+works frames ahead, so it yields the core to the frame in flight (the loop's thread, MediaPipe's
+threads, Zenoh's) instead of delaying it."""
+
+
+def lower_this_thread_priority(niceness: int) -> None:
+    """Raise the calling thread's niceness by `niceness` (Linux: per thread; elsewhere nothing)."""
+    if not hasattr(os, "setpriority") or not hasattr(threading, "get_native_id"):
+        return
+    try:
+        thread_id = threading.get_native_id()
+        current = os.getpriority(os.PRIO_PROCESS, thread_id)
+        os.setpriority(os.PRIO_PROCESS, thread_id, min(19, current + niceness))
+    except OSError as exc:
+        log.debug(
+            "cannot lower the priority of thread %s: %s", threading.current_thread().name, exc
+        )
+
+
+def _already_measured(detection: Any) -> Detection:
+    """`measure` of a detector whose `detect` does all of the landmark stage at once."""
+    return detection  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True, slots=True)
+class DetectorSteps:
+    """A detector's landmark stage as the loop runs it: `prepare` (no state; the decode thread),
+    `infer` (frames in order; the landmark thread) and `measure` (no state; the loop's thread).
+
+    `MediaPipeLandmarker` has the three; a detector with only `detect` (a test's fake) infers the
+    whole stage at once and `measure` passes its detection on.
+    """
+
+    prepare: Callable[[Any], Any] | None
+    infer: Callable[[Any, float | None], Any]
+    measure: Callable[[Any], Detection]
+
+    @classmethod
+    def of(cls, detector: LandmarkDetector) -> DetectorSteps:
+        prepare = getattr(detector, "prepare", None)
+        infer = getattr(detector, "infer", None)
+        measure = getattr(detector, "measure", None)
+        if prepare is not None and infer is not None and measure is not None:
+            return cls(prepare, infer, measure)
+        return cls(None, detector.detect, _already_measured)
+
+    def input_of(self, frame: Frame, prepared: Any) -> Any:
+        """What `infer` takes for `frame`: its image prepared (here if not beforehand) or as is."""
+        if prepared is not None:
+            return prepared
+        return frame.image if self.prepare is None else self.prepare(frame.image)
+
+
+@dataclass(frozen=True, slots=True)
+class Decoded:
+    """A frame from the source, with its image prepared for the detector when it could be."""
+
+    frame: Frame
+    prepared: Any = None
+    """What the detector's `prepare(image)` made of the image (None: not prepared)."""
+
+
+def decode_frames(
+    source: FrameSource, prepare: Callable[[Any], Any] | None, spent: deque[Any]
+) -> Iterator[Decoded]:
+    """The decode thread's part: each frame and its prepared image. Prepared images come back
+    through `spent` to be released here, off the other threads (a `mediapipe.Image`: 0.25 ms).
+    Runs `DECODE_NICENESS` below the rest of the loop."""
+    lower_this_thread_priority(DECODE_NICENESS)
+    for frame in source:
+        while spent:
+            spent.popleft()
+        yield Decoded(frame, None if prepare is None else prepare(frame.image))
+
+
+@dataclass(frozen=True, slots=True)
+class Inferred:
+    """A frame after the detector's `infer`, on its way to the loop's thread."""
+
+    frame: Frame
+    inference: Any
+    """What `DetectorSteps.infer` returned (for a plain detector, the `Detection`)."""
+    decode_ms: float
+    infer_ms: float
+    received_s: float
+    """When the landmark thread received the frame from its source (the loop's clock, after
+    pacing): the start of the frame's latency."""
+    inferred_s: float
+    """When `infer` ended (the loop's clock)."""
+
+
+class Pacer:
+    """Holds a file's frames back to its own timeline (`realtime` replay)."""
+
+    def __init__(self, clock: Callable[[], float]) -> None:
+        self._clock = clock
+        self._first_t_s: float | None = None
+        self._wall_start = 0.0
+
+    def wait(self, t_s: float) -> None:
+        if self._first_t_s is None:
+            self._first_t_s, self._wall_start = t_s, self._clock()
+        wait_s = self._wall_start + (t_s - self._first_t_s) - self._clock()
+        if wait_s > 0:
+            time.sleep(wait_s)
+
+
+def infer_frames(
+    items: Iterator[Decoded],
+    steps: DetectorSteps,
+    clock: Callable[[], float],
+    pacer: Pacer | None,
+    spent: deque[Any],
+) -> Iterator[Inferred]:
+    """The landmark thread's part: each frame through the detector's `infer`, in order. A
+    prepared image goes back through `spent` to the decode thread once MediaPipe is done with it."""
+    while True:
+        before = clock()
+        item = next(items, None)
+        decode_ms = (clock() - before) * 1e3
+        if item is None:
+            return
+        frame = item.frame
+        if pacer is not None:
+            pacer.wait(frame.t_s)
+        received_s = clock()
+        prepared = steps.input_of(frame, item.prepared)
+        inference = steps.infer(prepared, frame.t_s)
+        inferred_s = clock()
+        if item.prepared is not None:
+            spent.append(item.prepared)
+        del item, prepared  # the decode thread releases the prepared image
+        yield Inferred(
+            frame, inference, decode_ms, (inferred_s - received_s) * 1e3, received_s, inferred_s
+        )

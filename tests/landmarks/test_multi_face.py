@@ -16,6 +16,7 @@ from roadgaze.landmarks import MediaPipeLandmarker
 from roadgaze.landmarks.model_store import resolve_model
 from roadgaze.landmarks.multi_face import (
     MULTI_FACE_RETURN_S,
+    BackgroundCount,
     FaceMode,
     MultiFaceSwitch,
     detector_model_bytes,
@@ -148,3 +149,30 @@ def test_a_face_that_moves_away_from_the_tracked_place_is_found_on_the_same_fram
         moved = detector.detect(right, 0.5).driver
         assert detector.face_mode is FaceMode.SINGLE
     assert moved is not None and moved.box_px[0] > 400
+
+
+def test_a_periodic_count_is_taken_at_the_next_frame_even_when_it_is_slow() -> None:
+    """A replay gives the same results every time: a count started on one frame always takes
+    effect on the next, on whichever thread and however late it finishes."""
+    import threading
+    import time
+
+    threads: list[str] = []
+
+    class SlowCounter:
+        def count(self, image: object) -> int:
+            time.sleep(0.05)
+            threads.append(threading.current_thread().name)
+            return 2
+
+    background = BackgroundCount(SlowCounter())  # type: ignore[arg-type]
+    try:
+        assert background.take() is None
+        background.start(1.0, "frame 10")
+        background.start(1.1, "frame 11")  # one count at a time: ignored
+        assert background.pending
+        assert background.take() == (1.0, 2)
+        assert not background.pending and background.take() is None
+    finally:
+        background.close()
+    assert len(threads) == 1 and threads[0].startswith("roadgaze-facecount")

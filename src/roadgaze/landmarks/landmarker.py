@@ -293,13 +293,13 @@ class MediaPipeLandmarker(ClosesOnExit):
         """One frame of a stream: the one-face landmarker unless a count sees several faces."""
         switch, counter, background = self._switch, self._counter, self._background
         assert switch is not None and counter is not None and background is not None
-        finished = background.finished()
-        if finished is not None:
-            switch.counted(*finished)
+        started = background.take()  # a count started on the previous frame
+        if started is not None:
+            switch.counted(*started)
         if switch.check_due(t_s):
             if switch.next_check_t_s is None:  # the first frame: counted before it is tracked
                 switch.counted(t_s, counter.count(mp_image))
-            else:  # the periodic count, taken a frame or two later (the check period is 1 s)
+            else:  # the periodic count, beside this frame's landmarks, taken at the next frame
                 background.start(t_s, mp_image)
         if switch.mode is FaceMode.SINGLE:
             faces = self._find(self._single_landmarker, mp_image, size, timestamp_ms)

@@ -9,9 +9,10 @@ seconds, and whenever the tracked face jumps or comes back after a loss. Only wh
 two or more faces does the stream switch to the `max_faces` landmarker, where the driver rule
 (`landmarks.driver`) chooses; after `MULTI_FACE_RETURN_S` with at most one face it returns to the
 one-face landmarker. `MultiFaceSwitch` is that decision, pure and testable without MediaPipe.
-The periodic counts run on a thread of their own (`BackgroundCount`) and take effect a frame or
-two later, so the stream's landmark thread does not wait for them; the first frame's count and
-a count after a jump are made at once, because they decide that very frame.
+The periodic counts run on a thread of their own (`BackgroundCount`) beside that frame's
+landmarks and take effect at the next frame (always the next, so a replay gives the same
+results every time), so the stream's landmark thread does not wait for them; the first frame's
+count and a count after a jump are made at once, because they decide that very frame.
 """
 
 from __future__ import annotations
@@ -147,7 +148,8 @@ class FaceCounter:
 
 
 class BackgroundCount:
-    """One face count at a time on a thread of its own: `start` it, take it when `finished`."""
+    """One face count at a time on a thread of its own: `start` it on one frame, `take` it on
+    the next."""
 
     def __init__(self, counter: FaceCounter) -> None:
         self._counter = counter
@@ -163,10 +165,10 @@ class BackgroundCount:
         if self._pending is None:
             self._pending = (t_s, self._pool.submit(self._counter.count, image))
 
-    def finished(self) -> tuple[float, int] | None:
-        """(t_s, faces) of the count once it is done (then no count is pending), else None.
-        Raises what the count raised."""
-        if self._pending is None or not self._pending[1].done():
+    def take(self) -> tuple[float, int] | None:
+        """(t_s, faces) of the count started (waiting for it: it ran beside a whole frame's
+        landmarks, so it is done), None when none was started. Raises what the count raised."""
+        if self._pending is None:
             return None
         t_s, future = self._pending
         self._pending = None

@@ -66,7 +66,7 @@ def register(subparsers: Any) -> None:
         "--latency",
         action="store_true",
         help="add a pass at the video's frame rate publishing each frame's yaw message on Zenoh "
-        "(loopback) and report capture-to-delivery p50/p99 ms at a subscriber in the same process",
+        "(loopback) and report capture-to-delivery p50/p99 ms at a subscriber in another process",
     )
     parser.add_argument(
         "--repeat",
@@ -203,7 +203,6 @@ class LatencyPass:
     latency: LatencyResult
     stages: dict[str, StageStats]
     """This pass's per-stage times (the first `--warmup` frames left out)."""
-    frames: int
 
     @property
     def landmarks(self) -> StageStats | None:
@@ -224,7 +223,7 @@ def latency_pass(args: argparse.Namespace, config: Config) -> LatencyPass:
         published = result.summary.frames
         rig.probe.wait_for_count(published, 5.0)
         latency = rig.probe.result(published, skip_first=args.warmup)
-    return LatencyPass(latency, timings.stats(), published)
+    return LatencyPass(latency, timings.stats())
 
 
 def _round(value: float | None, digits: int) -> float | None:

@@ -100,10 +100,8 @@ class FoundFace:
 class Inference:
     """What MediaPipe found in one frame (`MediaPipeLandmarker.infer`), for `measure`."""
 
-    rgb: npt.NDArray[np.uint8]
-    """The image the faces were found in."""
     gray: npt.NDArray[np.uint8]
-    """`rgb` in grey, for the eye check."""
+    """The image the faces were found in, in grey (the eye check measures it)."""
     faces: tuple[FoundFace, ...]
     driver_index: int | None
     """VIDEO mode: the driver among `faces` (None: no face). IMAGE mode: None, `measure` chooses."""
@@ -263,26 +261,25 @@ class MediaPipeLandmarker(ClosesOnExit):
             )
             mirrored = self._find(self._mirror_landmarker, flipped, size, timestamp_ms)
         if not self._video:
-            return Inference(rgb, prepared.gray, tuple(faces), None, tuple(mirrored))
+            return Inference(prepared.gray, tuple(faces), None, tuple(mirrored))
         # Chosen on the faces of the original image (with `mirror_average` their merged
         # measurements keep these indices).
         driver_index = choose_driver(faces, self._config.driver, self._driver_box_px)
         self._driver_box_px = None if driver_index is None else faces[driver_index].box_px
         if self._switch is not None and self._switch.mode is FaceMode.MULTI:
             self._switch.seen(t_s or 0.0, len(faces), self._driver_box_px)
-        return Inference(rgb, prepared.gray, tuple(faces), driver_index, tuple(mirrored))
+        return Inference(prepared.gray, tuple(faces), driver_index, tuple(mirrored))
 
     def measure(self, inference: Inference) -> Detection:
         """The features of each face `infer` found (roll removed, eyes, quality) and the driver.
 
         Keeps no state, so it may run on another thread while `infer` works on the next frame.
         """
-        rgb = inference.rgb
-        faces = self._features(inference.faces, inference.gray)
+        gray = inference.gray
+        faces = self._features(inference.faces, gray)
         if self._mirror_landmarker is not None:
-            flipped_gray = np.ascontiguousarray(inference.gray[:, ::-1])
-            mirrored = self._features(inference.mirrored, flipped_gray)
-            faces = merge_mirrored(faces, mirrored, rgb.shape[1])
+            mirrored = self._features(inference.mirrored, np.ascontiguousarray(gray[:, ::-1]))
+            faces = merge_mirrored(faces, mirrored, gray.shape[1])
         if not self._video:
             return Detection(tuple(faces), choose_driver(faces, self._config.driver))
         return Detection(faces=tuple(faces), driver_index=inference.driver_index)

@@ -136,7 +136,12 @@ def _status_check() -> Any:
 def _raw_library(landmarker: Any) -> Any | None:
     """The `ctypes.CDLL` behind the landmarker's `SerialDispatcher`, None where there is none."""
     raw = getattr(getattr(landmarker, "_lib", None), "_lib", None)
-    needed = ("MpFaceLandmarkerDetectForVideo", "MpFaceLandmarkerDetectImage", "MpErrorFree")
+    needed = (
+        "MpFaceLandmarkerDetectForVideo",
+        "MpFaceLandmarkerDetectImage",
+        "MpFaceLandmarkerCloseResult",
+        "MpErrorFree",
+    )
     if not isinstance(raw, ctypes.CDLL) or _status_check() is None:
         return None
     return raw if all(hasattr(raw, name) for name in needed) else None

@@ -31,6 +31,7 @@ from roadgaze.pipeline.steps import (
     Pacer,
     decode_frames,
     infer_frames,
+    infer_one,
 )
 from roadgaze.pipeline.timing import RunSummary, StageTimes, StageTimings
 from roadgaze.pose import PoseEstimator
@@ -120,11 +121,7 @@ class Pipeline:
 
     def process(self, frame: Frame, decode_ms: float = 0.0) -> ProcessedFrame:
         """One frame through every stage on this thread; frames must come in time order."""
-        received_s = self._clock()
-        inference = self._steps.infer(self._steps.input_of(frame, None), frame.t_s)
-        inferred_s = self._clock()
-        infer_ms = (inferred_s - received_s) * 1e3
-        return self._finish(Inferred(frame, inference, decode_ms, infer_ms, received_s, inferred_s))
+        return self._finish(infer_one(frame, None, self._steps, self._clock, decode_ms))
 
     def _finish(self, inferred: Inferred) -> ProcessedFrame:
         """The faces measured, then pose, smoothing and monitor, for a frame after `infer`."""

@@ -107,12 +107,29 @@ class Inferred:
     inference: Any
     """What `DetectorSteps.infer` returned (for a plain detector, the `Detection`)."""
     decode_ms: float
-    infer_ms: float
     received_s: float
     """When the landmark thread received the frame from its source (the loop's clock, after
     pacing): the start of the frame's latency."""
     inferred_s: float
     """When `infer` ended (the loop's clock)."""
+
+    @property
+    def infer_ms(self) -> float:
+        return (self.inferred_s - self.received_s) * 1e3
+
+
+def infer_one(
+    frame: Frame,
+    prepared: Any,
+    steps: DetectorSteps,
+    clock: Callable[[], float],
+    decode_ms: float = 0.0,
+) -> Inferred:
+    """`frame` (with its image `prepared`, or None) through the detector's `infer`, timed from
+    now: the start of its latency."""
+    received_s = clock()
+    inference = steps.infer(steps.input_of(frame, prepared), frame.t_s)
+    return Inferred(frame, inference, decode_ms, received_s, clock())
 
 
 class Pacer:
@@ -146,16 +163,10 @@ def infer_frames(
         decode_ms = (clock() - before) * 1e3
         if item is None:
             return
-        frame = item.frame
         if pacer is not None:
-            pacer.wait(frame.t_s)
-        received_s = clock()
-        prepared = steps.input_of(frame, item.prepared)
-        inference = steps.infer(prepared, frame.t_s)
-        inferred_s = clock()
+            pacer.wait(item.frame.t_s)
+        inferred = infer_one(item.frame, item.prepared, steps, clock, decode_ms)
         if item.prepared is not None:
             spent.append(item.prepared)
-        del item, prepared  # the decode thread releases the prepared image
-        yield Inferred(
-            frame, inference, decode_ms, (inferred_s - received_s) * 1e3, received_s, inferred_s
-        )
+        del item  # the decode thread releases the prepared image
+        yield inferred

@@ -26,12 +26,13 @@ compromise between the two models.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from roadgaze.pose.geometry import PAPER_CONSTANTS, FaceModelConstants, center_ce
+from roadgaze.pose.geometry import PAPER_CONSTANTS, FaceModelConstants, center_ce, is_scalar
 from roadgaze.types import FloatArray
 
 __all__ = [
@@ -104,8 +105,42 @@ def full_range_yaw_deg(
 
     `mediapipe_yaw_deg` None or NaN gives plain Center-CE. NaN where Center-CE is undefined.
     """
+    if is_scalar(x_left, x_right, x_center) and (
+        mediapipe_yaw_deg is None or is_scalar(mediapipe_yaw_deg)
+    ):
+        return _full_range_of_scalars(x_left, x_right, x_center, mediapipe_yaw_deg, constants, face)
     inner = np.asarray(center_ce(x_left, x_right, x_center, face), dtype=np.float64)
     outer = np.asarray(clipped_cylinder_deg(x_left, x_right, x_center), dtype=np.float64)
     weight = np.asarray(blend_weight(mediapipe_yaw_deg, constants), dtype=np.float64)
     outer = np.where(np.isfinite(outer), outer, inner)
     return _scalar_or_array((1.0 - weight) * inner + weight * outer)
+
+
+def _full_range_of_scalars(
+    x_left: float,
+    x_right: float,
+    x_center: float,
+    mediapipe_yaw_deg: float | None,
+    constants: FullRangeConstants,
+    face: FaceModelConstants,
+) -> float:
+    """(F1) for one face in plain floats: the per-frame path, the same operations in the same
+    order as the array path above (`tests/pose/test_fullrange.py` checks that both agree)."""
+    inner = float(center_ce(x_left, x_right, x_center, face))
+    cue = math.nan if mediapipe_yaw_deg is None else abs(mediapipe_yaw_deg)
+    span = constants.cue_end_deg - constants.cue_start_deg
+    u = _clip((cue - constants.cue_start_deg) / span, 0.0, 1.0)
+    weight = u * u * (3.0 - 2.0 * u)
+    if not math.isfinite(weight):  # no cue: plain Center-CE
+        return inner
+    width = x_right - x_left
+    ratio = (2.0 * x_center - x_left - x_right) / width if width > 0 else math.nan
+    outer = math.degrees(math.asin(_clip(ratio, -1.0, 1.0)))  # NaN stays NaN
+    if not math.isfinite(outer):
+        outer = inner
+    return (1.0 - weight) * inner + weight * outer
+
+
+def _clip(value: float, low: float, high: float) -> float:
+    """`np.clip` of one float: NaN stays NaN."""
+    return value if math.isnan(value) else min(max(value, low), high)

@@ -14,17 +14,21 @@ from roadgaze.landmarks.eye_contrast import eye_contrast, polygon_mask
 from roadgaze.landmarks.eyes import (
     BLENDSHAPE_PITCH_PER_DEG,
     BLENDSHAPE_YAW_PER_DEG,
+    EYE_LANDMARKS,
     EYEBALL,
     EYES,
     LEFT_EYE,
     RIGHT_EYE,
+    EyeIndices,
     blendshape_direction_deg,
     driver_eyes,
     eye_features,
     head_rotation,
     iris_direction_deg,
     swap_sides,
+    upright_eye_points,
 )
+from roadgaze.landmarks.features import remove_roll
 
 WIDTH_PX = 30.0
 
@@ -309,3 +313,46 @@ def test_painted_sunglasses_hide_the_eyes(photo_face: object, shade: int) -> Non
     assert eyes is not None and face is not None and face.eye_contrast is not None
     assert max(face.eye_contrast) < 0.15
     assert eyes.occluded and not eyes.gaze_available and not eyes.closure_available
+
+
+def _iris_by_matrices(
+    upright: np.ndarray, eye: EyeIndices, scale: float, head_yaw: float, head_pitch: float
+) -> tuple[float, float]:
+    """The iris model as its docstring states it, with `head_rotation`'s matrix (the reference
+    for the per-frame path, which writes the matrix out in floats)."""
+    rotation = head_rotation(head_yaw, head_pitch)
+    middle = 0.5 * (upright[eye.outer] + upright[eye.inner])
+    centre_in_head = np.array([eye.lateral * EYEBALL.lam, -EYEBALL.mu, EYEBALL.b - EYEBALL.k])
+    centre = middle + (rotation @ (centre_in_head * scale))[:2]
+    dx, dy = (upright[eye.iris_center] - centre) / (EYEBALL.k * scale)
+    planar = math.hypot(dx, dy)
+    if planar > 1.0:
+        dx, dy, planar = dx / planar, dy / planar, 1.0
+    x, y, z = rotation.T @ np.array([dx, dy, math.sqrt(max(0.0, 1.0 - planar * planar))])
+    return math.degrees(math.atan2(x, z)), math.degrees(math.atan2(-y, math.hypot(x, z)))
+
+
+def test_the_iris_model_in_floats_equals_its_matrix_form() -> None:
+    rng = np.random.default_rng(3)
+    for _ in range(500):
+        head_yaw, head_pitch = rng.uniform(-60, 60), rng.uniform(-40, 40)
+        upright = built_landmarks(head_yaw, head_pitch, rng.uniform(-30, 30), rng.uniform(-20, 20))[
+            :, :2
+        ] + rng.normal(0.0, 3.0, (478, 2))  # off the model, some beyond the limb
+        scale = rng.uniform(10.0, 40.0)
+        for eye in EYES:
+            expected = _iris_by_matrices(upright, eye, scale, head_yaw, head_pitch)
+            assert iris_direction_deg(upright, eye, scale, head_yaw, head_pitch) == pytest.approx(
+                expected, abs=1e-9
+            )
+
+
+def test_the_eye_points_are_remove_roll_of_those_landmarks() -> None:
+    rng = np.random.default_rng(5)
+    points = rng.uniform(0.0, 640.0, (478, 3)).astype(np.float32)
+    for roll in (-35.0, -3.0, 0.0, 12.0, 80.0):
+        upright = upright_eye_points(points.astype(np.float64), roll)
+        reference = remove_roll(points, roll)
+        assert set(upright) == set(EYE_LANDMARKS)
+        for index, (x, y) in upright.items():
+            assert (x, y) == pytest.approx(tuple(reference[index]), abs=1e-9)

@@ -34,7 +34,12 @@ import numpy as np
 import numpy.typing as npt
 
 from roadgaze.config import EyesConfig
-from roadgaze.landmarks.features import NUM_LANDMARKS, remove_roll, roll_from_eyes_deg
+from roadgaze.landmarks.features import (
+    LEFT_EYE_OUTER,
+    NUM_LANDMARKS,
+    RIGHT_EYE_OUTER,
+    roll_from_eyes_deg,
+)
 from roadgaze.types import EyeMeasurement, EyesFeatures, FaceFeatures, FloatArray
 
 
@@ -92,6 +97,21 @@ LEFT_EYE = EyeIndices(
     look_down="eyeLookDownLeft",
 )
 EYES = (RIGHT_EYE, LEFT_EYE)
+EYE_LANDMARKS = tuple(
+    sorted(
+        {RIGHT_EYE_OUTER, LEFT_EYE_OUTER}
+        | {i for e in EYES for i in (e.outer, e.inner, e.iris_center)}
+        | {i for e in EYES for pair in e.lid_pairs for i in pair}
+    )
+)
+"""The landmarks `eye_features` measures (corners, lids, iris centres; the eye line's ends)."""
+EYE_LANDMARKS_LIST = list(EYE_LANDMARKS)
+_RIGHT_OUTER_ROW = EYE_LANDMARKS.index(RIGHT_EYE_OUTER)
+_LEFT_OUTER_ROW = EYE_LANDMARKS.index(LEFT_EYE_OUTER)
+
+UprightPoints = Mapping[int, tuple[float, float]] | FloatArray
+"""Roll-removed landmark (x, y) by landmark index: `upright_eye_points`' mapping, or an (N, 2)
+array such as `remove_roll`'s."""
 
 BLENDSHAPE_YAW_PER_DEG = 0.0229
 """eyeLookOut - eyeLookIn per degree of eye-in-head yaw: the slope on rendered eyes turned
@@ -142,14 +162,8 @@ def head_rotation(yaw_deg: float, pitch_deg: float) -> FloatArray:
     return np.asarray(rotate_pitch @ rotate_yaw, dtype=np.float64)
 
 
-def direction_deg(vector: FloatArray) -> tuple[float, float]:
-    """Yaw and pitch (degrees) of a direction given as (x right, y down, z toward the camera)."""
-    x, y, z = (float(v) for v in vector)
-    return math.degrees(math.atan2(x, z)), math.degrees(math.atan2(-y, math.hypot(x, z)))
-
-
 def iris_direction_deg(
-    upright_px: FloatArray,
+    upright_px: UprightPoints,
     eye: EyeIndices,
     scale_px: float,
     head_yaw_deg: float,
@@ -162,19 +176,31 @@ def iris_direction_deg(
     head frame; it is projected with the head rotation, and the iris centre's offset from it
     divided by k W is the x, y of the unit gaze vector in the camera frame. Rotated back by the
     head it gives the eye-in-head direction; for pitch 0, sin(yaw_head + yaw_eye) = dx / (k W).
+    `upright_px[i]` is landmark i's roll-removed (x, y). Plain floats: `head_rotation`'s matrix
+    written out (the per-frame path; `tests/landmarks/test_eyes.py` checks it against the matrix).
     """
-    rotation = head_rotation(head_yaw_deg, head_pitch_deg)
-    middle = 0.5 * (upright_px[eye.outer] + upright_px[eye.inner])
-    centre_in_head = np.array(
-        [eye.lateral * constants.lam, -constants.mu, constants.b - constants.k]
-    ) * (scale_px)
-    centre_px = middle + (rotation @ centre_in_head)[:2]
-    dx, dy = (upright_px[eye.iris_center] - centre_px) / (constants.k * scale_px)
+    yaw, pitch = math.radians(head_yaw_deg), math.radians(head_pitch_deg)
+    cos_y, sin_y, cos_p, sin_p = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
+    # head_rotation(yaw, pitch) = [[cy, 0, sy], [sp sy, cp, -sp cy], [-cp sy, sp, cp cy]].
+    outer_x, outer_y = _xy(upright_px, eye.outer)
+    inner_x, inner_y = _xy(upright_px, eye.inner)
+    iris_x, iris_y = _xy(upright_px, eye.iris_center)
+    c0 = eye.lateral * constants.lam * scale_px
+    c1 = -constants.mu * scale_px
+    c2 = (constants.b - constants.k) * scale_px
+    centre_x = 0.5 * (outer_x + inner_x) + (cos_y * c0 + sin_y * c2)
+    centre_y = 0.5 * (outer_y + inner_y) + (sin_p * sin_y * c0 + cos_p * c1 - sin_p * cos_y * c2)
+    radius_px = constants.k * scale_px
+    dx, dy = (iris_x - centre_x) / radius_px, (iris_y - centre_y) / radius_px
     planar = math.hypot(dx, dy)
     if planar > 1.0:  # further out than an eyeball allows: saturate at the limb
         dx, dy, planar = dx / planar, dy / planar, 1.0
-    gaze_camera = np.array([dx, dy, math.sqrt(max(0.0, 1.0 - planar * planar))])
-    return direction_deg(rotation.T @ gaze_camera)
+    dz = math.sqrt(max(0.0, 1.0 - planar * planar))
+    # The gaze back in the head frame: the transpose of the rotation applied to (dx, dy, dz).
+    x = cos_y * dx + sin_p * sin_y * dy - cos_p * sin_y * dz
+    y = cos_p * dy + sin_p * dz
+    z = sin_y * dx - sin_p * cos_y * dy + cos_p * cos_y * dz
+    return math.degrees(math.atan2(x, z)), math.degrees(math.atan2(-y, math.hypot(x, z)))
 
 
 def blendshape_direction_deg(
@@ -194,10 +220,39 @@ def blendshape_direction_deg(
     return toward_left / BLENDSHAPE_YAW_PER_DEG, up_minus_down / BLENDSHAPE_PITCH_PER_DEG
 
 
-def lid_openness(upright_px: FloatArray, eye: EyeIndices, scale_px: float) -> float:
+def lid_openness(upright_px: UprightPoints, eye: EyeIndices, scale_px: float) -> float:
     """Mean vertical lid gap of the eye's lid pairs / `scale_px` (negative when lids cross)."""
-    gaps = [upright_px[lower, 1] - upright_px[upper, 1] for upper, lower in eye.lid_pairs]
-    return float(np.mean(gaps)) / scale_px
+    total = 0.0
+    for upper, lower in eye.lid_pairs:
+        total += _xy(upright_px, lower)[1] - _xy(upright_px, upper)[1]
+    return total / len(eye.lid_pairs) / scale_px
+
+
+def eye_width_px(upright_px: UprightPoints, eye: EyeIndices) -> float:
+    """Outer to inner corner of one eye in the image, pixels."""
+    outer_x, outer_y = _xy(upright_px, eye.outer)
+    inner_x, inner_y = _xy(upright_px, eye.inner)
+    return math.hypot(outer_x - inner_x, outer_y - inner_y)
+
+
+def upright_eye_points(points: FloatArray, roll_deg: float) -> dict[int, tuple[float, float]]:
+    """The roll-removed (x, y) of the landmarks the eye measures use (`EYE_LANDMARKS`), by index:
+    `remove_roll` on those points only, in plain floats."""
+    rows: list[list[float]] = points[EYE_LANDMARKS_LIST, :2].tolist()
+    pivot_x = 0.5 * (rows[_RIGHT_OUTER_ROW][0] + rows[_LEFT_OUTER_ROW][0])
+    pivot_y = 0.5 * (rows[_RIGHT_OUTER_ROW][1] + rows[_LEFT_OUTER_ROW][1])
+    angle = math.radians(roll_deg)
+    cos_a, sin_a = math.cos(angle), math.sin(angle)
+    upright = {}
+    for index, (x, y) in zip(EYE_LANDMARKS, rows, strict=True):
+        dx, dy = x - pivot_x, y - pivot_y
+        upright[index] = (cos_a * dx - sin_a * dy + pivot_x, sin_a * dx + cos_a * dy + pivot_y)
+    return upright
+
+
+def _xy(upright_px: UprightPoints, index: int) -> tuple[float, float]:
+    point = upright_px[index]
+    return float(point[0]), float(point[1])
 
 
 def _face_reason(
@@ -244,8 +299,8 @@ def eye_features(
         raise ValueError(f"expected ({NUM_LANDMARKS}, 2|3) landmarks, found shape {points.shape}")
     if not np.all(np.isfinite(points[:, :2])):
         raise ValueError("landmarks contain NaN or infinite values")
-    upright = remove_roll(points, roll_from_eyes_deg(points))
-    widths = {e.side: float(np.linalg.norm(upright[e.outer] - upright[e.inner])) for e in EYES}
+    upright = upright_eye_points(points, roll_from_eyes_deg(points))
+    widths = {e.side: eye_width_px(upright, e) for e in EYES}
     scale = max(widths.values())
     yaw = None if head_yaw_deg is None or not math.isfinite(head_yaw_deg) else head_yaw_deg
     pitch = 0.0 if head_pitch_deg is None or not math.isfinite(head_pitch_deg) else head_pitch_deg

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.pose.geometry import is_scalar
 from roadgaze.types import FloatArray
 
 __all__ = [
@@ -166,6 +167,9 @@ def head_pitch_deg(
     the driver's road-ahead pose, not at the camera's axis. Float in gives float out, arrays give
     an array; NaN stays NaN.
     """
+    if is_scalar(model_pitch_deg, neutral_pitch_deg):  # the per-frame path, in plain floats
+        offset = model_pitch_deg - neutral_pitch_deg
+        return float(neutral_pitch_deg + (down_gain * offset if offset < 0.0 else offset))
     pitch = np.asarray(model_pitch_deg, dtype=np.float64)
     neutral = np.asarray(neutral_pitch_deg, dtype=np.float64)
     offset = pitch - neutral

@@ -25,6 +25,7 @@ doing harm where the raw series is already good (docs/pose.md has the measuremen
 from __future__ import annotations
 
 import math
+import operator
 import statistics
 from collections import deque
 from dataclasses import dataclass
@@ -112,6 +113,10 @@ class SmootherState:
     """Restarts after a gap or after a run of rejections (the first start is not counted)."""
 
 
+_value = operator.itemgetter(1)
+"""The value of a (t_s, value) pair."""
+
+
 def _inverse_1x1(matrix: FloatArray) -> FloatArray:
     """The inverse of a 1x1 matrix."""
     return np.asarray(1.0 / matrix, dtype=np.float64)
@@ -135,7 +140,7 @@ class AngleSmoother:
         self._recent: deque[tuple[float, float]] = deque()
         """Accepted (t_s, value) within `clamp_window_s`: bounded by the frame rate."""
         self._history: deque[tuple[float, float]] = deque(maxlen=3)
-        self._residuals: deque[float] = deque(maxlen=self.config.noise_window)
+        self._abs_residuals: deque[float] = deque(maxlen=self.config.noise_window)
         self._noise_std_deg = self.config.measurement_std_deg
         self._consecutive_rejections = 0
         self._rejected_total = 0
@@ -270,10 +275,10 @@ class AngleSmoother:
         (t0, z0), (t1, z1), (t2, z2) = self._history
         ratio = (t2 - t1) / (t1 - t0)
         residual = z2 - z1 - (z1 - z0) * ratio  # as `extrapolation_residuals`, one at a time
-        self._residuals.append(residual / math.sqrt(1.0 + (1.0 + ratio) ** 2 + ratio**2))
+        self._abs_residuals.append(abs(residual) / math.sqrt(1.0 + (1.0 + ratio) ** 2 + ratio**2))
         config = self.config
-        if len(self._residuals) >= config.min_noise_samples:
-            spread = statistics.median(abs(r) for r in self._residuals)
+        if len(self._abs_residuals) >= config.min_noise_samples:
+            spread = statistics.median(self._abs_residuals)
             self._noise_std_deg = max(MAD_TO_STD * spread, config.min_measurement_std_deg)
 
     def _clamp(self, t_s: float, value_deg: float | None) -> None:
@@ -283,8 +288,8 @@ class AngleSmoother:
             recent.append((t_s, value_deg))
         while len(recent) > 1 and recent[0][0] <= t_s - self.config.clamp_window_s:
             recent.popleft()
-        low = min(value for _, value in recent)
-        high = max(value for _, value in recent)
+        low = min(recent, key=_value)[1]
+        high = max(recent, key=_value)[1]
         self._filter.x[0, 0] = min(max(float(self._filter.x[0, 0]), low), high)
 
     def _estimate(self) -> SmoothedAngle:

@@ -1,4 +1,4 @@
-"""The driver's eyes from MediaPipe's 478 landmarks and blendshapes (pure numpy).
+"""The driver's eyes from MediaPipe's 478 landmarks and blendshapes (plain floats and numpy, no I/O).
 
 `eye_features(...)` measures, per eye, the lid aperture (openness), the eye-in-head direction and
 whether the eye can be used, and returns an `EyesFeatures`. Definitions (measured choices and
@@ -34,84 +34,41 @@ import numpy as np
 import numpy.typing as npt
 
 from roadgaze.config import EyesConfig
-from roadgaze.landmarks.features import (
-    LEFT_EYE_OUTER,
-    NUM_LANDMARKS,
-    RIGHT_EYE_OUTER,
-    roll_from_eyes_deg,
+from roadgaze.landmarks.eye_landmarks import (
+    EYE_LANDMARKS,
+    EYES,
+    LEFT_EYE,
+    RIGHT_EYE,
+    EyeIndices,
+    UprightPoints,
+    eye_width_px,
+    lid_openness,
+    upright_eye_points,
+    xy,
 )
+from roadgaze.landmarks.features import NUM_LANDMARKS, roll_from_eyes_deg
 from roadgaze.types import EyeMeasurement, EyesFeatures, FaceFeatures, FloatArray
 
-
-@dataclass(frozen=True, slots=True)
-class EyeIndices:
-    """MediaPipe landmark indices and blendshape names of one eye (the person's own side)."""
-
-    side: str
-    outer: int
-    inner: int
-    lid_pairs: tuple[tuple[int, int], ...]
-    """(upper, lower) lid landmarks, the centre pair first."""
-    iris_center: int
-    iris_ring: tuple[int, int, int, int]
-    """Iris contour: image right, top, image left, bottom."""
-    contour: tuple[int, ...]
-    """The eye opening as a closed loop: outer corner, upper lid, inner corner, lower lid."""
-    lateral: float
-    """+1 when the eye's outer corner lies toward the image right (the person's left eye)."""
-    blink: str
-    look_in: str
-    look_out: str
-    look_up: str
-    look_down: str
-
-
-RIGHT_EYE = EyeIndices(
-    side="right",
-    outer=33,
-    inner=133,
-    lid_pairs=((159, 145), (158, 153), (160, 144)),
-    iris_center=468,
-    iris_ring=(469, 470, 471, 472),
-    contour=(33, 246, 161, 160, 159, 158, 157, 173, 133, 155, 154, 153, 145, 144, 163, 7),
-    lateral=-1.0,
-    blink="eyeBlinkRight",
-    look_in="eyeLookInRight",
-    look_out="eyeLookOutRight",
-    look_up="eyeLookUpRight",
-    look_down="eyeLookDownRight",
-)
-LEFT_EYE = EyeIndices(
-    side="left",
-    outer=263,
-    inner=362,
-    lid_pairs=((386, 374), (385, 380), (387, 373)),
-    iris_center=473,
-    iris_ring=(474, 475, 476, 477),
-    contour=(263, 466, 388, 387, 386, 385, 384, 398, 362, 382, 381, 380, 374, 373, 390, 249),
-    lateral=1.0,
-    blink="eyeBlinkLeft",
-    look_in="eyeLookInLeft",
-    look_out="eyeLookOutLeft",
-    look_up="eyeLookUpLeft",
-    look_down="eyeLookDownLeft",
-)
-EYES = (RIGHT_EYE, LEFT_EYE)
-EYE_LANDMARKS = tuple(
-    sorted(
-        {RIGHT_EYE_OUTER, LEFT_EYE_OUTER}
-        | {i for e in EYES for i in (e.outer, e.inner, e.iris_center)}
-        | {i for e in EYES for pair in e.lid_pairs for i in pair}
-    )
-)
-"""The landmarks `eye_features` measures (corners, lids, iris centres; the eye line's ends)."""
-EYE_LANDMARKS_LIST = list(EYE_LANDMARKS)
-_RIGHT_OUTER_ROW = EYE_LANDMARKS.index(RIGHT_EYE_OUTER)
-_LEFT_OUTER_ROW = EYE_LANDMARKS.index(LEFT_EYE_OUTER)
-
-UprightPoints = Mapping[int, tuple[float, float]] | FloatArray
-"""Roll-removed landmark (x, y) by landmark index: `upright_eye_points`' mapping, or an (N, 2)
-array such as `remove_roll`'s."""
+__all__ = [  # the eye landmarks are re-exported from their own module, where they moved
+    "BLENDSHAPE_PITCH_PER_DEG",
+    "BLENDSHAPE_YAW_PER_DEG",
+    "EYEBALL",
+    "EYES",
+    "EYE_LANDMARKS",
+    "LEFT_EYE",
+    "RIGHT_EYE",
+    "EyeIndices",
+    "EyeballConstants",
+    "blendshape_direction_deg",
+    "driver_eyes",
+    "eye_features",
+    "eye_width_px",
+    "head_rotation",
+    "iris_direction_deg",
+    "lid_openness",
+    "swap_sides",
+    "upright_eye_points",
+]
 
 BLENDSHAPE_YAW_PER_DEG = 0.0229
 """eyeLookOut - eyeLookIn per degree of eye-in-head yaw: the slope on rendered eyes turned
@@ -182,9 +139,9 @@ def iris_direction_deg(
     yaw, pitch = math.radians(head_yaw_deg), math.radians(head_pitch_deg)
     cos_y, sin_y, cos_p, sin_p = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
     # head_rotation(yaw, pitch) = [[cy, 0, sy], [sp sy, cp, -sp cy], [-cp sy, sp, cp cy]].
-    outer_x, outer_y = _xy(upright_px, eye.outer)
-    inner_x, inner_y = _xy(upright_px, eye.inner)
-    iris_x, iris_y = _xy(upright_px, eye.iris_center)
+    outer_x, outer_y = xy(upright_px, eye.outer)
+    inner_x, inner_y = xy(upright_px, eye.inner)
+    iris_x, iris_y = xy(upright_px, eye.iris_center)
     c0 = eye.lateral * constants.lam * scale_px
     c1 = -constants.mu * scale_px
     c2 = (constants.b - constants.k) * scale_px
@@ -218,41 +175,6 @@ def blendshape_direction_deg(
         return None
     toward_left = out_minus_in if eye.side == "left" else -out_minus_in
     return toward_left / BLENDSHAPE_YAW_PER_DEG, up_minus_down / BLENDSHAPE_PITCH_PER_DEG
-
-
-def lid_openness(upright_px: UprightPoints, eye: EyeIndices, scale_px: float) -> float:
-    """Mean vertical lid gap of the eye's lid pairs / `scale_px` (negative when lids cross)."""
-    total = 0.0
-    for upper, lower in eye.lid_pairs:
-        total += _xy(upright_px, lower)[1] - _xy(upright_px, upper)[1]
-    return total / len(eye.lid_pairs) / scale_px
-
-
-def eye_width_px(upright_px: UprightPoints, eye: EyeIndices) -> float:
-    """Outer to inner corner of one eye in the image, pixels."""
-    outer_x, outer_y = _xy(upright_px, eye.outer)
-    inner_x, inner_y = _xy(upright_px, eye.inner)
-    return math.hypot(outer_x - inner_x, outer_y - inner_y)
-
-
-def upright_eye_points(points: FloatArray, roll_deg: float) -> dict[int, tuple[float, float]]:
-    """The roll-removed (x, y) of the landmarks the eye measures use (`EYE_LANDMARKS`), by index:
-    `remove_roll` on those points only, in plain floats."""
-    rows: list[list[float]] = points[EYE_LANDMARKS_LIST, :2].tolist()
-    pivot_x = 0.5 * (rows[_RIGHT_OUTER_ROW][0] + rows[_LEFT_OUTER_ROW][0])
-    pivot_y = 0.5 * (rows[_RIGHT_OUTER_ROW][1] + rows[_LEFT_OUTER_ROW][1])
-    angle = math.radians(roll_deg)
-    cos_a, sin_a = math.cos(angle), math.sin(angle)
-    upright = {}
-    for index, (x, y) in zip(EYE_LANDMARKS, rows, strict=True):
-        dx, dy = x - pivot_x, y - pivot_y
-        upright[index] = (cos_a * dx - sin_a * dy + pivot_x, sin_a * dx + cos_a * dy + pivot_y)
-    return upright
-
-
-def _xy(upright_px: UprightPoints, index: int) -> tuple[float, float]:
-    point = upright_px[index]
-    return float(point[0]), float(point[1])
 
 
 def _face_reason(

@@ -8,12 +8,14 @@ import os
 import sys
 import threading
 from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 import pytest
 
 from fakes import ListSource, ScriptedDetector
+from roadgaze.capture import SourceInfo
 from roadgaze.pipeline import Pipeline
 from roadgaze.pipeline.runtime import (
     MIDDLE_EVERY_FRAMES,
@@ -67,6 +69,11 @@ def loop_threads() -> set[str]:
     return {t.name for t in threading.enumerate() if t.name.startswith("roadgaze-")}
 
 
+def values(record: Any) -> tuple[Any, ...]:
+    sample = record.sample
+    return (sample.t_s, sample.yaw_raw_deg, sample.yaw_deg, sample.yaw_rate_dps, record.verdict)
+
+
 def yaws(count: int) -> list[float | None]:
     return [float(i % 30) for i in range(count)]
 
@@ -84,11 +91,62 @@ def test_a_file_is_decoded_inferred_and_measured_on_three_threads_in_order() -> 
     one_by_one = Pipeline(StagedDetector(yaws(40)))
     expected = [one_by_one.process(frame).record for frame in ListSource(40)]
 
-    def values(record: Any) -> tuple[Any, ...]:
-        sample = record.sample
-        return (sample.t_s, sample.yaw_raw_deg, sample.yaw_deg, sample.yaw_rate_dps, record.verdict)
-
     assert [values(r) for r in records] == [values(r) for r in expected]
+    assert loop_threads() == set()
+
+
+class LiveListSource(ListSource):
+    """`ListSource` as a camera: live, so it is never paced and never read ahead."""
+
+    @property
+    def info(self) -> SourceInfo:
+        return replace(super().info, live=True)
+
+
+@pytest.mark.parametrize("paced", ["camera", "realtime file"])
+def test_a_paced_source_goes_straight_through_on_the_loops_thread(paced: str) -> None:
+    """A camera, or a file at its own rate, is slower than the loop: no hand-over to another
+    thread adds to a frame's latency. The records are those of the threaded loop."""
+    count = 12
+    detector = StagedDetector(yaws(count))
+    pipeline = Pipeline(detector)
+    if paced == "camera":
+        frames = pipeline.frames(LiveListSource(count, fps=200.0))
+        expected_prepare = {threading.current_thread().name}  # the detector's input_of, here
+    else:
+        frames = pipeline.frames(ListSource(count, fps=200.0), realtime=True)
+        expected_prepare = {"roadgaze-decode"}
+    during: list[set[str]] = []
+    records = []
+    for processed in frames:
+        records.append(processed.record)
+        during.append(loop_threads())
+    here = threading.current_thread().name
+    assert detector.threads["infer"] == {here}
+    assert detector.threads["measure"] == {here}
+    assert detector.threads["prepare"] == expected_prepare
+    assert all("roadgaze-landmarks" not in names for names in during)
+    assert [r.frame for r in records] == list(range(count))
+    threaded_loop = Pipeline(StagedDetector(yaws(count))).frames(ListSource(count, fps=200.0))
+    threaded = [p.record for p in threaded_loop]
+    assert [values(r) for r in records] == [values(r) for r in threaded]
+    assert loop_threads() == set()
+
+
+def test_a_paced_loop_stops_and_reports_errors_as_the_threaded_one() -> None:
+    detector = StagedDetector(yaws(30), fail_at=7)
+    seen: list[int] = []
+    with pytest.raises(ValueError, match="failed on frame 7"):
+        for processed in Pipeline(detector).frames(LiveListSource(30)):
+            seen.append(processed.record.frame)
+    assert seen == list(range(7))
+    detector = StagedDetector(yaws(30))
+    stop = threading.Event()
+    for processed in Pipeline(detector).frames(LiveListSource(30), stop=stop):
+        if processed.record.frame == 4:
+            stop.set()
+    assert detector.inferred == list(range(5))  # nothing is inferred ahead of the loop
+    assert Pipeline(StagedDetector(yaws(30))).run(LiveListSource(30), max_frames=3).frames == 3
     assert loop_threads() == set()
 
 

@@ -166,9 +166,12 @@ class Pipeline:
         ends the loop before the next frame.
 
         A file is decoded, and each image prepared for the detector, in a thread of its own
-        `READ_AHEAD_FRAMES` ahead; a camera grabs in its own thread. MediaPipe runs in the
-        landmark thread (`roadgaze.pipeline.steps`), handing each frame over as soon as it is
-        done; the rest runs on the caller's thread while MediaPipe works on the next frame.
+        `READ_AHEAD_FRAMES` ahead; a camera grabs in its own thread. A file read flat out runs
+        MediaPipe in the landmark thread (`roadgaze.pipeline.steps`), handing each frame over as
+        soon as it is done, and the rest on the caller's thread while MediaPipe works on the
+        next frame: throughput. A camera, or a file paced at its own rate, delivers frames more
+        slowly than the loop runs, so there a frame goes straight through on the caller's
+        thread: no hand-over between threads adds to its latency (`docs/pipeline.md`).
         """
         spent: deque[Any] = deque(maxlen=2 * READ_AHEAD_FRAMES + 2)
         produced = 0
@@ -183,12 +186,14 @@ class Pipeline:
                 decoding = Handoff(decoded, "roadgaze-decode", READ_AHEAD_FRAMES)
                 items = iter(stack.enter_context(decoding))
             pacer = Pacer(self._clock) if realtime and not source.info.live else None
-            inferring = Handoff(
-                infer_frames(items, self._steps, self._clock, pacer, spent),
-                "roadgaze-landmarks",
-                INFER_AHEAD_FRAMES,
-            )
-            inferred = iter(stack.enter_context(inferring))
+            in_order = infer_frames(items, self._steps, self._clock, pacer, spent)
+            inferred: Iterator[Inferred]
+            if source.info.live or realtime:
+                inferred = in_order
+                stack.callback(in_order.close)
+            else:
+                inferring = Handoff(in_order, "roadgaze-landmarks", INFER_AHEAD_FRAMES)
+                inferred = iter(stack.enter_context(inferring))
             while max_frames is None or produced < max_frames:
                 if stop is not None and stop.is_set():
                     return

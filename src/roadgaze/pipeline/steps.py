@@ -5,6 +5,10 @@ Per frame the decode thread reads the frame and prepares its image for the detec
 thread measures the faces, estimates the pose, runs the monitor and feeds the sinks. MediaPipe
 releases Python's lock while it works, so on a second core everything else overlaps with the
 inference of the next frame and the loop runs at MediaPipe's own rate.
+
+A camera, or a file paced at its own rate, delivers frames more slowly than that, so for them
+the loop's own thread runs `infer_frames` too: each frame goes straight through, without a
+hand-over between threads in its latency.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ import os
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -154,9 +158,10 @@ def infer_frames(
     clock: Callable[[], float],
     pacer: Pacer | None,
     spent: deque[Any],
-) -> Iterator[Inferred]:
-    """The landmark thread's part: each frame through the detector's `infer`, in order. A
-    prepared image goes back through `spent` to the decode thread once MediaPipe is done with it."""
+) -> Generator[Inferred, None, None]:
+    """The landmark thread's part (the loop's own for a paced source): each frame through the
+    detector's `infer`, in order. A prepared image goes back through `spent` to the decode
+    thread once MediaPipe is done with it."""
     while True:
         before = clock()
         item = next(items, None)

@@ -216,12 +216,16 @@ def test_the_scalar_path_agrees_with_the_array_path(model: str) -> None:
     right = left + rng.uniform(-20.0, 300.0, 2000)
     center = left + (right - left) * rng.uniform(-0.3, 1.3, 2000)
     edges = np.array(np.meshgrid(EDGE_VALUES, EDGE_VALUES, EDGE_VALUES)).reshape(3, -1)
-    left, right, center = (np.concatenate([a, b]) for a, b in zip((left, right, center), edges))
+    left, right, center = (
+        np.concatenate([a, b]) for a, b in zip((left, right, center), edges, strict=True)
+    )
     function = YAW_MODELS[model]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         by_array = function(left, right, center)
-        by_float = np.array([function(*map(float, face)) for face in zip(left, right, center)])
+        by_float = np.array(
+            [function(*map(float, face)) for face in zip(left, right, center, strict=True)]
+        )
     assert np.array_equal(np.isnan(by_array), np.isnan(by_float))
     assert np.isfinite(by_array).sum() > 1000  # the centre inside the face for most
     np.testing.assert_allclose(by_float, by_array, rtol=0.0, atol=1e-12, equal_nan=True)

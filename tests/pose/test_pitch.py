@@ -102,7 +102,9 @@ def test_the_scalar_path_of_the_down_gain_agrees_with_the_array_path() -> None:
     pitch = np.concatenate([rng.uniform(-60.0, 60.0, 500), [np.nan, np.inf, -np.inf, 0.0]])
     neutral = np.concatenate([rng.uniform(-15.0, 15.0, 500), [0.0, 0.0, 0.0, np.nan]])
     by_array = head_pitch_deg(pitch, neutral, 1.7)
-    by_float = [head_pitch_deg(float(p), float(n), 1.7) for p, n in zip(pitch, neutral)]
+    by_float = [
+        head_pitch_deg(float(p), float(n), 1.7) for p, n in zip(pitch, neutral, strict=True)
+    ]
     assert all(isinstance(value, float) for value in by_float)
     np.testing.assert_array_equal(by_float, by_array)
 

@@ -1,4 +1,4 @@
-"""The driver's eyes from MediaPipe's 478 landmarks and blendshapes (plain floats and numpy, no I/O).
+"""The driver's eyes from MediaPipe's 478 landmarks and blendshapes (plain floats, numpy; no I/O).
 
 `eye_features(...)` measures, per eye, the lid aperture (openness), the eye-in-head direction and
 whether the eye can be used, and returns an `EyesFeatures`. Definitions (measured choices and

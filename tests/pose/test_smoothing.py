@@ -8,7 +8,12 @@ import pytest
 
 from roadgaze.config import SmoothingConfig
 from roadgaze.pose.offline import excursion_deg
-from roadgaze.pose.smoothing import AngleSmoother, extrapolation_residuals, robust_noise_std_deg
+from roadgaze.pose.smoothing import (
+    AngleSmoother,
+    ConstantVelocityFilter,
+    extrapolation_residuals,
+    robust_noise_std_deg,
+)
 
 FPS = 30.0
 
@@ -246,10 +251,95 @@ def test_the_process_noise_is_filterpys_piecewise_white_acceleration(dt_s: float
     np.testing.assert_array_equal(transition, [[1.0, dt_s], [0.0, 1.0]])
 
 
-def test_the_filters_inverse_of_its_1x1_innovation_covariance_is_numpys() -> None:
-    from roadgaze.pose.smoothing import _inverse_1x1
+class FilterpyFilter:
+    """filterpy's `KalmanFilter` behind `ConstantVelocityFilter`'s interface: the reference."""
 
-    for value in np.random.default_rng(3).uniform(1e-4, 1e4, 1000):
-        matrix = np.array([[value]])
-        assert _inverse_1x1(matrix) == np.linalg.inv(matrix)  # bit for bit
-    assert AngleSmoother()._filter.inv is _inverse_1x1
+    def __init__(self) -> None:
+        from filterpy.kalman import KalmanFilter
+
+        self.kalman = KalmanFilter(dim_x=2, dim_z=1)
+        self.kalman.H = np.array([[1.0, 0.0]])
+
+    angle = property(
+        lambda self: float(self.kalman.x[0, 0]),
+        lambda self, value: self.kalman.x.__setitem__((0, 0), value),
+    )
+    rate = property(lambda self: float(self.kalman.x[1, 0]))
+    p00 = property(lambda self: float(self.kalman.P[0, 0]))
+
+    def start(self, angle: float, angle_var: float, rate_var: float) -> None:
+        self.kalman.x = np.array([[angle], [0.0]])
+        self.kalman.P = np.diag([angle_var, rate_var])
+
+    def predict(self, dt_s: float, acceleration_var: float) -> None:
+        from filterpy.common import Q_discrete_white_noise
+
+        noise = Q_discrete_white_noise(dim=2, dt=dt_s, var=acceleration_var)
+        self.kalman.predict(F=np.array([[1.0, dt_s], [0.0, 1.0]]), Q=noise)
+
+    def update(self, measured: float, measurement_var: float) -> None:
+        self.kalman.update(np.array([[measured]]), R=np.array([[measurement_var]]))
+
+    def hold(self) -> None:
+        self.kalman.x[1, 0] = 0.0
+
+    def restart_rate(self, rate_var: float) -> None:
+        self.kalman.x[1, 0] = 0.0
+        self.kalman.P[0, 1] = self.kalman.P[1, 0] = 0.0
+        self.kalman.P[1, 1] = rate_var
+
+
+def drive_with_faults(seed: int, count: int = 3000) -> list[tuple[float, float | None]]:
+    """Head turns with noise, irregular frame times, short and long gaps, single outliers and
+    runs of them (which restart the track)."""
+    rng = np.random.default_rng(seed)
+    t = np.cumsum(rng.uniform(0.02, 0.12, count))
+    yaw = 30.0 * np.sin(t / 1.7) * np.sin(t / 5.3) + rng.normal(0.0, rng.uniform(0.2, 3.0), count)
+    values: list[float | None] = [float(v) for v in yaw]
+    for start in rng.integers(0, count - 40, 25):
+        length = int(rng.integers(1, 30))  # up to 3.5 s: some past `reinit_gap_s`
+        values[start : start + length] = [None] * length
+    for index in rng.integers(0, count, 40):
+        values[index] = float(yaw[index] + rng.choice([-1, 1]) * rng.uniform(20, 80))
+    for start in rng.integers(0, count - 10, 6):
+        values[start : start + 6] = [float(yaw[start] + 60.0)] * 6
+    return list(zip(t.tolist(), values, strict=True))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_float_filter_agrees_with_filterpys_kalman_filter(seed: int) -> None:
+    """The smoother with `ConstantVelocityFilter` and with filterpy's `KalmanFilter` in its
+    place give the same estimates, frame by frame, through gaps, outliers and restarts."""
+    ours, reference = AngleSmoother(), AngleSmoother()
+    reference._filter = FilterpyFilter()  # type: ignore[assignment]
+    events = 0
+    for t_s, value in drive_with_faults(seed):
+        mine, theirs = ours.update(t_s, value), reference.update(t_s, value)
+        assert (mine is None) == (theirs is None)
+        if mine is not None and theirs is not None:
+            assert mine.angle_deg == pytest.approx(theirs.angle_deg, rel=1e-9, abs=1e-9)
+            assert mine.rate_dps == pytest.approx(theirs.rate_dps, rel=1e-9, abs=1e-7)
+            assert mine.std_deg == pytest.approx(theirs.std_deg, rel=1e-9)
+        assert ours.state.rejected_total == reference.state.rejected_total
+        assert ours.state.reinitialisations == reference.state.reinitialisations
+    events = ours.state.rejected_total + ours.state.reinitialisations
+    assert ours.state.rejected_total > 20 and ours.state.reinitialisations > 5 and events > 30
+
+
+def test_the_float_filters_matrices_are_filterpys() -> None:
+    """One predict and one update from a random state, against filterpy's matrix products."""
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        ours, reference = ConstantVelocityFilter(), FilterpyFilter()
+        angle, angle_var, rate_var = rng.uniform(-50, 50), rng.uniform(0.1, 50), rng.uniform(1, 900)
+        ours.start(angle, angle_var, rate_var)
+        reference.start(angle, angle_var, rate_var)
+        dt_s, var = rng.uniform(0.01, 0.5), rng.uniform(1.0, 1e6)
+        ours.predict(dt_s, var)
+        reference.predict(dt_s, var)
+        measured, measurement_var = rng.uniform(-60, 60), rng.uniform(0.01, 25)
+        ours.update(measured, measurement_var)
+        reference.update(measured, measurement_var)
+        covariance = [[ours.p00, ours.p01], [ours.p01, ours.p11]]
+        np.testing.assert_allclose([ours.angle, ours.rate], reference.kalman.x[:, 0], rtol=1e-12)
+        np.testing.assert_allclose(covariance, reference.kalman.P, rtol=1e-9, atol=1e-12)

@@ -72,7 +72,7 @@ def machine() -> str:
     except (OSError, AttributeError):
         pass
     versions = []
-    for name in ("mediapipe", "opencv-python-headless", "opencv-contrib-python", "eclipse-zenoh"):
+    for name in ("mediapipe", "opencv-contrib-python", "opencv-python-headless", "eclipse-zenoh"):
         try:
             versions.append(f"{name} {importlib.metadata.version(name)}")
         except importlib.metadata.PackageNotFoundError:

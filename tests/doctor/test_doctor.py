@@ -89,7 +89,7 @@ def test_two_opencv_builds_in_one_folder_warn_with_the_fix(monkeypatch: pytest.M
     assert second.status is Status.WARN and second.detail.startswith("opencv-python-headless")
     assert second.fix is not None and second.fix.startswith(
         "pip uninstall -y opencv-contrib-python opencv-python-headless && "
-        "pip install --no-deps --force-reinstall opencv-python-headless==5.0.0.93"
+        "pip install --no-deps --force-reinstall opencv-contrib-python==5.0.0.93"
     )
 
 
@@ -113,11 +113,24 @@ def test_opencv_verdicts(
     assert statuses(check_opencv()) == expected
 
 
-def test_opencv_fix_keeps_the_headless_version() -> None:
-    assert opencv_fix({"opencv-contrib-python": "5.0.0.93"}) == (
-        "pip uninstall -y opencv-contrib-python && "
-        "pip install --no-deps --force-reinstall opencv-python-headless==5.0.0.93"
+def test_opencv_fix_keeps_the_build_mediapipe_requires_at_its_version() -> None:
+    both = {"opencv-python-headless": "5.0.0.93", "opencv-contrib-python": "5.1.0.95"}
+    assert opencv_fix(both) == (
+        "pip uninstall -y opencv-contrib-python opencv-python-headless && "
+        "pip install --no-deps --force-reinstall opencv-contrib-python==5.1.0.95"
     )
+    assert opencv_fix({}) == "pip install --no-deps --force-reinstall opencv-contrib-python"
+
+
+def test_this_install_has_one_opencv_and_the_doctor_passes_it() -> None:
+    """The README's own install leaves one distribution in `cv2/` (0.1's two failed doctor)."""
+    installed = {
+        name: version
+        for name in software.OPENCV_DISTRIBUTIONS
+        if (version := software.distribution_version(name)) is not None
+    }
+    assert list(installed) == ["opencv-contrib-python"]
+    assert statuses(check_opencv()) == [Status.OK]
 
 
 def test_missing_gl_libraries_fail(monkeypatch: pytest.MonkeyPatch) -> None:

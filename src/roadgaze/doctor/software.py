@@ -1,9 +1,11 @@
 """Doctor checks of the software: versions, which OpenCV build `cv2` really is, EGL/GLES.
 
-`mediapipe` depends on `opencv-contrib-python` and roadgaze on `opencv-python-headless`; both
-install the same `cv2/` folder, the last one installed wins, `pip check` says nothing, and
-uninstalling one breaks `import cv2`. The files on disk are matched against each distribution's
-RECORD (SHA-256 of the `cv2` binary) to tell which build is really loaded. `libmediapipe.so`
+Every OpenCV distribution installs the same `cv2/` folder: with two installed (roadgaze 0.1
+asked for `opencv-python-headless` beside mediapipe's `opencv-contrib-python`) the last one
+installed wins, `pip check` says nothing, and uninstalling one breaks `import cv2`. roadgaze now
+asks for the one mediapipe requires, so a plain install has one. The files on disk are matched
+against each distribution's RECORD (SHA-256 of the `cv2` binary) to tell which build is really
+loaded. `libmediapipe.so`
 needs `libEGL.so.1` and `libGLESv2.so.2` even on the CPU.
 """
 
@@ -33,11 +35,11 @@ KEY_PACKAGES = (
     "scikit-image",
 )
 """roadgaze's dependencies besides OpenCV (which has its own check)."""
-IMPORTS = {"mediapipe": "mediapipe", "zenoh": "eclipse-zenoh", "cv2": "opencv-python-headless"}
+IMPORTS = {"mediapipe": "mediapipe", "zenoh": "eclipse-zenoh", "cv2": "opencv-contrib-python"}
 """Modules whose import is tried, with the distribution that provides them."""
 OPENCV_DISTRIBUTIONS = (
-    "opencv-python-headless",
     "opencv-contrib-python",
+    "opencv-python-headless",
     "opencv-python",
     "opencv-contrib-python-headless",
 )
@@ -110,13 +112,14 @@ def _file_hash(path: Path) -> str:
 
 
 def opencv_fix(installed: dict[str, str]) -> str:
-    """The commands that leave only the headless build, at the version installed."""
-    version = installed.get("opencv-python-headless") or next(iter(installed.values()), "")
+    """The commands that leave only the build mediapipe requires (`opencv-contrib-python`), at
+    the version installed (a headless image swaps in `opencv-contrib-python-headless` instead:
+    docs/deployment.md)."""
+    keep = "opencv-contrib-python"
+    version = installed.get(keep) or next(iter(installed.values()), "")
     pin = f"=={version}" if version else ""
-    return (
-        f"pip uninstall -y {' '.join(sorted(installed))} && "
-        f"pip install --no-deps --force-reinstall opencv-python-headless{pin}"
-    )
+    uninstall = f"pip uninstall -y {' '.join(sorted(installed))} && " if installed else ""
+    return f"{uninstall}pip install --no-deps --force-reinstall {keep}{pin}"
 
 
 def check_opencv() -> list[Check]:
@@ -163,7 +166,7 @@ def check_opencv() -> list[Check]:
                 Status.WARN,
                 f"{', '.join(f'{name} {installed[name]}' for name in others)} also installed "
                 "into cv2/: whichever is installed last replaces the other's files",
-                opencv_fix(installed) + "  (keeps the headless build; README, OpenCV)",
+                opencv_fix(installed) + "  (keeps the build mediapipe requires; README, OpenCV)",
             )
         )
     return checks

@@ -5,6 +5,7 @@ alerts and logs; images dropped (counted) but records never; a failed write in o
 from __future__ import annotations
 
 import errno
+import itertools
 import logging
 import threading
 import time
@@ -28,8 +29,9 @@ from roadgaze.outputs.foxglove.channels import (
     TOPIC_LOG,
     TOPIC_RECORD,
     TOPIC_STATE,
+    TOPICS,
 )
-from roadgaze.outputs.foxglove.open import replay_recorder
+from roadgaze.outputs.foxglove.open import replay_recorder, vehicle_recorder
 from roadgaze.outputs.foxglove.recorder import FoxgloveRecorder
 from roadgaze.outputs.foxglove.targets import TrackedFile
 from roadgaze.outputs.records import record_fields
@@ -102,11 +104,14 @@ def test_every_message_is_stamped_with_its_frames_capture_time(
 ) -> None:
     contents = read_mcap(recording[0])
     frame_ns = [round(record.t_s * 1e9) for record, _ in RECORDS]
-    for topic in (TOPIC_RECORD, TOPIC_LIMITS, TOPIC_ANNOTATIONS):
-        stamps = [message.log_time for message in contents.messages[topic]]
-        assert stamps == frame_ns, topic
+    stamps = [message.log_time for message in contents.messages[TOPIC_RECORD]]
+    assert stamps == frame_ns
+    image_ns = [message.log_time for message in contents.messages[TOPIC_IMAGE]]
+    annotation_ns = [message.log_time for message in contents.messages[TOPIC_ANNOTATIONS]]
+    assert annotation_ns == image_ns  # drawn on the camera frames
+    for topic in TOPICS:
         assert all(m.publish_time == m.log_time for m in contents.messages[topic])
-    for topic in (TOPIC_IMAGE, TOPIC_ALERTS, TOPIC_STATE):
+    for topic in (TOPIC_IMAGE, TOPIC_LIMITS, TOPIC_ALERTS, TOPIC_STATE):
         stamps = [message.log_time for message in contents.messages[topic]]
         assert stamps == sorted(stamps) and set(stamps) <= set(frame_ns), topic
 
@@ -146,20 +151,34 @@ def test_annotations_draw_the_face_in_image_pixels(
     # No roll: the boundaries are vertical lines at the roll-removed x.
     assert [p.x for p in centre.points] == pytest.approx([record.sample.features.x_center_px] * 2)
     assert [p.x for p in left.points] == pytest.approx([record.sample.features.x_left_px] * 2)
-    assert len(landmarks.points) == 25  # on frames with an image only
-    second = protobuf_message(
-        contents, TOPIC_ANNOTATIONS, contents.messages[TOPIC_ANNOTATIONS][1].data
-    )
-    assert len(second.points) == 4
+    assert len(landmarks.points) == 25
     assert "zone road" in first.texts[0].text
+    turned = [
+        protobuf_message(contents, TOPIC_ANNOTATIONS, message.data)
+        for message in contents.messages[TOPIC_ANNOTATIONS]
+    ]
+    assert any(len(a.texts) == 2 and a.texts[1].text.startswith("ACTIVE: ") for a in turned)
 
 
 def test_limits_are_the_road_zone_around_the_neutral_and_the_thresholds(
     recording: tuple[Path, FoxgloveRecorder],
 ) -> None:
     monitor = Config().monitor
-    limits = read_mcap(recording[0]).json(TOPIC_LIMITS)
-    for (record, _), limit in zip(RECORDS, limits, strict=True):
+    contents = read_mcap(recording[0])
+    limits = contents.json(TOPIC_LIMITS)
+    stamps = [message.log_time for message in contents.messages[TOPIC_LIMITS]]
+    at = {round(record.t_s * 1e9): record for record, _ in RECORDS}
+    # Logged when the learned neutral moves, and at least every state interval (1 s).
+    changed = [
+        round(b.t_s * 1e9)
+        for (a, _), (b, _) in itertools.pairwise(RECORDS)
+        if (a.verdict.neutral_yaw_deg, a.verdict.neutral_pitch_deg)
+        != (b.verdict.neutral_yaw_deg, b.verdict.neutral_pitch_deg)
+    ]
+    assert stamps[0] == 0 and set(changed) <= set(stamps)
+    assert max(b - a for a, b in itertools.pairwise(stamps)) <= 1_000_000_000
+    for stamp, limit in zip(stamps, limits, strict=True):
+        record = at[stamp]
         neutral = record.verdict.neutral_yaw_deg
         assert limit["yaw_min_deg"] == pytest.approx(
             neutral - monitor.road_half_width_deg, abs=1e-3
@@ -318,3 +337,32 @@ def test_a_failed_write_ends_a_replay_in_one_line(
             recorder.on_record(record, frame)
             time.sleep(0.002)
     assert recorder.failure is not None and 0 < recorder.records_written < len(RECORDS)
+
+
+def test_a_stopped_recording_is_a_problem_of_the_services_state(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from roadgaze.transport import Health, Keys
+
+    def full(self: TrackedFile, data: bytes | bytearray) -> int:
+        self.error = OSError(errno.ENOSPC, "No space left on device")
+        raise self.error
+
+    config = config_with(flush_s=0.05)
+    health = Health(config, Keys.from_config(config.zenoh), None, "numbered")
+    recorder = vehicle_recorder(config, "numbered", tmp_path, None, health.state_json)
+    health.problem_checks.append(recorder.problem)
+    assert health.state_message().problems == []
+    monkeypatch.setattr(TrackedFile, "write", full)
+    with recorder:
+        for record, frame in RECORDS[:30]:
+            health.on_record(record, frame)
+            recorder.on_record(record, frame)  # never raises on the vehicle
+            time.sleep(0.01)
+    state = health.state_message()
+    assert state.status == "degraded"
+    assert any(
+        p.startswith("recording stopped: cannot write MCAP")
+        and p.endswith("No space left on device")
+        for p in state.problems
+    )

@@ -78,7 +78,9 @@ def test_segments_rotate_by_age(tmp_path: Path) -> None:
 def test_the_oldest_segments_are_removed_to_keep_the_folder_under_its_bound(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
-    settings = RecordConfig(segment_mb=0.02, max_disk_mb=0.05, flush_s=0.05, images=False)
+    settings = RecordConfig(
+        segment_mb=0.06, max_disk_mb=0.15, flush_s=0.05, image_fps=30.0, images=True
+    )
     stranger = tmp_path / "notes.mcap"
     stranger.write_bytes(b"not ours" * 10_000)
     with caplog.at_level(logging.WARNING, logger="roadgaze"):

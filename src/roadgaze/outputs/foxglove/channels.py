@@ -164,63 +164,44 @@ def face_annotations(
     roll-removed frame, its landmarks (`with_landmarks`), the verdict's line and the active
     alerts, in the pixels of the image scaled by `scale`."""
     stamp = timestamp(stamp_ns)
+
+    def shape(
+        kind: PointsAnnotationType, pairs: Iterable[Any], colour: Color, thickness: float
+    ) -> PointsAnnotation:
+        return PointsAnnotation(
+            timestamp=stamp,
+            type=kind,
+            points=_points(pairs, scale),
+            outline_color=colour,
+            thickness=thickness,
+        )
+
+    def text(y_px: float, line: str, background: Color) -> TextAnnotation:
+        return TextAnnotation(
+            timestamp=stamp,
+            position=Point2(x=8.0, y=y_px),
+            text=line,
+            font_size=14.0,
+            text_color=TEXT_COLOUR,
+            background_color=background,
+        )
+
     points: list[PointsAnnotation] = []
     features = record.sample.features
     if features is not None:
         x_min, y_min, x_max, y_max = features.box_px
         corners = ((x_min, y_min), (x_max, y_min), (x_max, y_max), (x_min, y_max))
-        points.append(
-            PointsAnnotation(
-                timestamp=stamp,
-                type=PointsAnnotationType.LineLoop,
-                points=_points(corners, scale),
-                outline_color=BOX_COLOUR,
-                thickness=1.0,
-            )
-        )
+        points.append(shape(PointsAnnotationType.LineLoop, corners, BOX_COLOUR, 1.0))
         for name, ends in face_lines_px(features):
-            points.append(
-                PointsAnnotation(
-                    timestamp=stamp,
-                    type=PointsAnnotationType.LineStrip,
-                    points=_points(((ends[0, 0], ends[0, 1]), (ends[1, 0], ends[1, 1])), scale),
-                    outline_color=CENTRE_COLOUR if name == "centre" else BOUNDARY_COLOUR,
-                    thickness=2.0,
-                )
-            )
+            colour = CENTRE_COLOUR if name == "centre" else BOUNDARY_COLOUR
+            points.append(shape(PointsAnnotationType.LineStrip, ends.tolist(), colour, 2.0))
         if with_landmarks and len(features.landmarks_px):
             xy = features.landmarks_px[:, :2].tolist()
-            points.append(
-                PointsAnnotation(
-                    timestamp=stamp,
-                    type=PointsAnnotationType.Points,
-                    points=_points(xy, scale),
-                    outline_color=LANDMARK_COLOUR,
-                    thickness=2.0,
-                )
-            )
-    texts = [
-        TextAnnotation(
-            timestamp=stamp,
-            position=Point2(x=8.0, y=20.0),
-            text=verdict_text(record),
-            font_size=14.0,
-            text_color=TEXT_COLOUR,
-            background_color=TEXT_BACKGROUND,
-        )
-    ]
+            points.append(shape(PointsAnnotationType.Points, xy, LANDMARK_COLOUR, 2.0))
+    texts = [text(20.0, verdict_text(record), TEXT_BACKGROUND)]
     if record.verdict.active:
         active = ", ".join(kind.value for kind in record.verdict.active)
-        texts.append(
-            TextAnnotation(
-                timestamp=stamp,
-                position=Point2(x=8.0, y=42.0),
-                text=f"ACTIVE: {active}",
-                font_size=14.0,
-                text_color=TEXT_COLOUR,
-                background_color=ALERT_BACKGROUND,
-            )
-        )
+        texts.append(text(42.0, f"ACTIVE: {active}", ALERT_BACKGROUND))
     return ImageAnnotations(timestamp=stamp, points=points, texts=texts)
 
 
@@ -231,9 +212,18 @@ class FrameChannels:
     Not thread-safe by itself: the recorder calls it under one lock.
     """
 
-    def __init__(self, context: foxglove.Context, monitor: MonitorConfig, vehicle_id: str) -> None:
+    def __init__(
+        self,
+        context: foxglove.Context,
+        monitor: MonitorConfig,
+        vehicle_id: str,
+        limits_interval_ns: int = 1_000_000_000,
+    ) -> None:
         self.monitor = monitor
         self.vehicle_id = vehicle_id
+        self.limits_interval_ns = limits_interval_ns
+        self._limits_neutral: tuple[float, float] | None = None
+        self._limits_due_ns = 0
         self.image = CompressedImageChannel(TOPIC_IMAGE, context=context)
         self.annotations = ImageAnnotationsChannel(TOPIC_ANNOTATIONS, context=context)
         self.record = foxglove.Channel(
@@ -267,15 +257,24 @@ class FrameChannels:
         self,
         record: FrameRecord,
         stamp_ns: int,
+        annotate: bool,
         scale: float,
         with_landmarks: bool,
         wall_time_s: float,
     ) -> None:
-        """The record, the limits, the annotations and the alerts raised on this frame."""
+        """The record, the limits when they changed (or `limits_interval_ns` after the last),
+        the annotations when `annotate` (the frame carries a camera image: they are drawn on
+        it), and the alerts raised on this frame."""
         self.record.log(_json_bytes(record_fields(record)), log_time=stamp_ns)
-        self.limits.log(_json_bytes(limits_fields(record, self.monitor)), log_time=stamp_ns)
-        annotations = face_annotations(record, stamp_ns, scale, with_landmarks)
-        self.annotations.log(annotations, log_time=stamp_ns)
+        verdict = record.verdict
+        neutral = (verdict.neutral_yaw_deg, verdict.neutral_pitch_deg)
+        if neutral != self._limits_neutral or stamp_ns >= self._limits_due_ns:
+            self.limits.log(_json_bytes(limits_fields(record, self.monitor)), log_time=stamp_ns)
+            self._limits_neutral = neutral
+            self._limits_due_ns = stamp_ns + self.limits_interval_ns
+        if annotate:
+            annotations = face_annotations(record, stamp_ns, scale, with_landmarks)
+            self.annotations.log(annotations, log_time=stamp_ns)
         for alert in record.alerts:
             message = AlertMessage.from_alert(
                 alert, self.vehicle_id, self.alerts_logged, wall_time_s
@@ -304,5 +303,9 @@ class FrameChannels:
         self.log.log(line, log_time=stamp_ns)
 
 
+_ENCODER = json.JSONEncoder(allow_nan=False, separators=(",", ":"))
+"""One encoder for every message (`json.dumps` with options builds a new one each call)."""
+
+
 def _json_bytes(fields: dict[str, Any]) -> bytes:
-    return json.dumps(fields, allow_nan=False, separators=(",", ":")).encode()
+    return _ENCODER.encode(fields).encode()

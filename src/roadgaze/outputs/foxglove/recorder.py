@@ -42,6 +42,11 @@ log = logging.getLogger(__name__)
 IMAGES_WAITING = 2
 """Camera frames waiting for the image thread at most; a newer one is dropped (and counted)."""
 PUT_WAIT_S = 0.5
+WRITE_BATCH_S = 0.1
+"""The writer thread takes what was queued this long after the first item, in one go: Python
+run warm on a batch costs about a third of the same work woken frame by frame (the caches,
+docs/pipeline.md), and the loop's thread is interrupted once per batch, not once per frame. The
+live view shows a frame at most this late."""
 IMAGE_NICENESS = 10
 _STOP = object()
 
@@ -124,7 +129,12 @@ class FoxgloveRecorder(ClosesOnExit):
         self._wall_clock_stamps = wall_clock_stamps
         self._state = state
         self._context = foxglove.Context()
-        self._channels = FrameChannels(self._context, config.monitor, config.zenoh.vehicle_id)
+        self._channels = FrameChannels(
+            self._context,
+            config.monitor,
+            config.zenoh.vehicle_id,
+            limits_interval_ns=round(self.settings.state_interval_s * 1e9),
+        )
         self._lock = threading.Lock()
         self._records: queue.Queue[Any] = queue.Queue(maxsize=self.settings.queue_frames)
         self._images: queue.Queue[Any] = queue.Queue(maxsize=IMAGES_WAITING)
@@ -132,6 +142,7 @@ class FoxgloveRecorder(ClosesOnExit):
         self._last_stamp_ns = 0
         self._next_image_t_s = -float("inf")
         self._failure: RoadgazeError | None = None
+        self._next_state_ns = -(2**63)
         self._closed = False
         self.records_queued = 0
         self.records_written = 0
@@ -257,31 +268,35 @@ class FoxgloveRecorder(ClosesOnExit):
             "roadgaze.config": config,
         }
 
+    def _next_batch(self) -> tuple[list[Any], bool]:
+        """The items queued: waits for the first (at most `flush_s`), then `WRITE_BATCH_S`
+        more, and takes all; True once the stop was among them."""
+        try:
+            items = [self._records.get(timeout=self.settings.flush_s)]
+        except queue.Empty:
+            return [], False
+        if items[0] is not _STOP:
+            time.sleep(WRITE_BATCH_S)
+        while items[-1] is not _STOP:
+            try:
+                items.append(self._records.get_nowait())
+            except queue.Empty:
+                break
+        stopping = items[-1] is _STOP
+        return (items[:-1] if stopping else items), stopping
+
     def _write_loop(self) -> None:
         started_cpu_s = time.thread_time()
         next_tick_s = time.monotonic() + self.settings.flush_s
-        next_state_ns: int | None = None
-        while True:
-            try:
-                item = self._records.get(timeout=self.settings.flush_s)
-            except queue.Empty:
-                item = None
-            if item is _STOP:
-                break
+        stopping = False
+        while not stopping:
+            items, stopping = self._next_batch()
             if self._failure is not None:
                 continue
             try:
                 with self._lock:
-                    if isinstance(item, _FrameItem):
-                        self._write_frame(item)
-                        if self._state is not None and (
-                            next_state_ns is None or item.stamp_ns >= next_state_ns
-                        ):
-                            self._channels.log_state(self._state(), item.stamp_ns)
-                            interval_ns = round(self.settings.state_interval_s * 1e9)
-                            next_state_ns = item.stamp_ns + interval_ns
-                    elif isinstance(item, _LogItem):
-                        self._channels.log_line(item.entry, item.message, item.stamp_ns)
+                    for item in items:
+                        self._write(item)
                     now_s = time.monotonic()
                     if now_s >= next_tick_s:
                         next_tick_s = now_s + self.settings.flush_s
@@ -291,10 +306,22 @@ class FoxgloveRecorder(ClosesOnExit):
                 self._fail(exc)
         self.writer_cpu_s = time.thread_time() - started_cpu_s
 
+    def _write(self, item: Any) -> None:
+        if isinstance(item, _LogItem):
+            self._channels.log_line(item.entry, item.message, item.stamp_ns)
+            return
+        self._write_frame(item)
+        if self._state is not None and item.stamp_ns >= self._next_state_ns:
+            self._channels.log_state(self._state(), item.stamp_ns)
+            self._next_state_ns = item.stamp_ns + round(self.settings.state_interval_s * 1e9)
+
     def _write_frame(self, item: _FrameItem) -> None:
         scale = min(1.0, self.settings.image_width_px / max(1, item.width_px))
-        landmarks = item.with_image and self.settings.landmarks
-        self._channels.log_frame(item.record, item.stamp_ns, scale, landmarks, time.time())
+        landmarks = self.settings.landmarks
+        channels = self._channels
+        channels.log_frame(
+            item.record, item.stamp_ns, item.with_image, scale, landmarks, time.time()
+        )
         self.records_written += 1
 
     def _image_loop(self) -> None:

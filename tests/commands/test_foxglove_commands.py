@@ -220,3 +220,23 @@ def test_without_the_extra_each_flag_is_one_line_naming_it(
     ]
     assert time.monotonic() - started < 60.0  # said before any model or camera is opened
     assert not (tmp_path / "rec").exists()
+
+
+def test_bench_record_reports_what_recording_costs(
+    drive: Path, capsys: pytest.CaptureFixture[str], restore_logging: None
+) -> None:
+    args = ["bench", str(drive), "--record", "--no-raw", "--json", "--warmup", "5"]
+    assert main(args) == 0
+    cost = json.loads(capsys.readouterr().out)["recording"]
+    assert [p["kind"] for p in cost["passes"]] == ["none", "records", "images"]
+    frames = cost["passes"][0]["frames"]
+    assert all(p["frames"] == frames for p in cost["passes"])
+    records, images = cost["records"], cost["images"]
+    assert records["total_ms_per_frame"] == pytest.approx(
+        records["loop_thread_cpu_ms_per_frame"] + records["writer_thread_cpu_ms_per_frame"],
+        abs=2e-4,
+    )
+    assert 0 < records["loop_thread_cpu_ms_per_frame"] < records["writer_thread_cpu_ms_per_frame"]
+    assert cost["passes"][1]["images"] == 0 and cost["passes"][2]["images"] > 0
+    assert images["images_per_frame"] == pytest.approx(5.0 / 15.0, abs=0.02)  # 5 of 15 fps
+    assert images["image_thread_cpu_ms_per_image"] > 0 and len(cost["load_average_before"]) == 3

@@ -2,12 +2,14 @@
 
 Well-known Foxglove schemas where one fits: the camera frames (`foxglove.CompressedImage`), the
 face's box, boundaries, centre line and landmarks with the verdict's text
-(`foxglove.ImageAnnotations`, in the pixels of the recorded image) and the logs
-(`foxglove.Log`). JSON Schema channels for roadgaze's own: the frame record (`record_fields`,
-its schema derived from `RECORD_SCHEMA`, so a new field flows in without a change here), the
-monitor's limits of that frame (the road zone around the learned neutral, the timers'
-thresholds), the alerts and the state (the `roadgaze schema` messages). Every message is
-stamped with its frame's capture time (`log_time` = `publish_time`, and the header stamps).
+(`foxglove.ImageAnnotations`, in the pixels of the recorded image, with each camera frame they
+are drawn on) and the logs (`foxglove.Log`). JSON Schema channels for roadgaze's own: the
+frame record (`record_fields`, every frame; its schema derived from `RECORD_SCHEMA`, so a new
+field flows in without a change here), the monitor's limits (the road zone around the learned
+neutral, the timers' thresholds; when the neutral moves, and at least every state interval),
+the alerts and the state (the messages `roadgaze schema` prints, named by their version, so a
+new alert kind or field flows in too). Every message is stamped with its frame's capture time
+(`log_time` = `publish_time`, and the header stamps).
 """
 
 from __future__ import annotations

@@ -1,11 +1,11 @@
 """The pipeline sink that records every frame to MCAP and serves it live, off the loop's thread.
 
 On the loop's thread `on_record` only stamps the record with its capture time and queues it (and,
-at `record.image_fps`, the frame's image): about 10 us. A writer thread turns each record into
-its messages (`FrameChannels`) and logs them to the targets (an MCAP file, the rotating
-segments, the live server), ticks them every `record.flush_s` and records the state every
-`record.state_interval_s`; an image thread (at lower priority) scales and encodes the camera
-frames. The record queue is bounded and never drops: the loop waits when it is full (logged). A
+at `record.image_fps`, the frame's image): about 10 us. A writer thread takes what was queued
+every `WRITE_BATCH_S`, turns each record into its messages (`FrameChannels`) and logs them to
+the targets (an MCAP file, the rotating segments, the live server), ticks them every
+`record.flush_s` and records the state every `record.state_interval_s`; an image thread (at
+lower priority) scales and encodes the camera frames. The record queue is bounded and never drops: the loop waits when it is full (logged). A
 camera frame is dropped (and counted) when two wait already, unless `block_on_images` (a replay
 read flat out waits instead, so its recording has every frame it asked for). roadgaze's log
 lines (INFO and up) are recorded too, stamped with the capture time of the last frame queued.

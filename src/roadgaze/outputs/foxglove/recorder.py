@@ -5,10 +5,11 @@ at `record.image_fps`, the frame's image): about 10 us. A writer thread takes wh
 every `WRITE_BATCH_S`, turns each record into its messages (`FrameChannels`) and logs them to
 the targets (an MCAP file, the rotating segments, the live server), ticks them every
 `record.flush_s` and records the state every `record.state_interval_s`; an image thread (at
-lower priority) scales and encodes the camera frames. The record queue is bounded and never drops: the loop waits when it is full (logged). A
-camera frame is dropped (and counted) when two wait already, unless `block_on_images` (a replay
-read flat out waits instead, so its recording has every frame it asked for). roadgaze's log
-lines (INFO and up) are recorded too, stamped with the capture time of the last frame queued.
+lower priority) scales and encodes the camera frames. The record queue is bounded and never
+drops: the loop waits when it is full (logged). A camera frame is dropped (and counted) when two
+wait already, unless `block_on_images` (a replay read flat out waits instead, so its recording
+has every frame it asked for). roadgaze's log lines (INFO and up) are recorded too, stamped with
+the capture time of the last frame queued.
 
 Capture time: on the source's timeline (`t_s`) for a replay, so the recording's clock is the
 video's; on the wall clock for `run` (`t_s` plus the offset between the two at the first frame),

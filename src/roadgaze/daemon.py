@@ -13,6 +13,7 @@ import logging
 from collections.abc import Iterator
 from contextlib import ExitStack, closing, contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 
 from roadgaze.config import Config
 from roadgaze.pipeline import Sink, SpeedSource, no_speed
@@ -79,13 +80,17 @@ def run_daemon(
     stop: StopFlag | None = None,
     realtime: bool = True,
     handle_signals: bool = True,
+    record_dir: Path | None = None,
+    foxglove: str | None = None,
 ) -> int:
     """Monitor `source_spec` and publish until the source ends or a stop; returns 0.
 
     A camera that cannot be opened is waited for with backoff (capture.reconnect_*) and reported
     in the state as degraded; a missing file is a `SourceError`. An unreachable Zenoh peer never
     stops monitoring (see `ZenohLink`). Under systemd (`$NOTIFY_SOCKET`) it sends READY, WATCHDOG
-    and STOPPING notifications (see `roadgaze.service.supervision`).
+    and STOPPING notifications (see `roadgaze.service.supervision`). `record_dir` records MCAP
+    segments there and `foxglove` (`[HOST:]PORT`) serves the live view (docs/foxglove.md); a
+    recording that fails is reported in the state, never fatal.
     """
     from roadgaze import capture
     from roadgaze.pipeline import Pipeline, create_detector
@@ -100,6 +105,15 @@ def run_daemon(
         )
         bus = stack.enter_context(bus_outputs(config, source_spec, publish=True))
         health = bus.health
+        extra: tuple[Sink, ...] = ()
+        if record_dir is not None or foxglove is not None:
+            from roadgaze.outputs.foxglove.open import vehicle_recorder
+
+            recorder = vehicle_recorder(
+                config, source_spec, record_dir, foxglove, health.state_json
+            )
+            health.problem_checks.append(recorder.problem)
+            extra = (stack.enter_context(recorder),)
         # The model loads before the camera opens, so no frame waits for MediaPipe.
         supervisor.status("loading the face landmarker model")
         detector = stack.enter_context(closing(create_detector(config)))
@@ -115,7 +129,10 @@ def run_daemon(
         )
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         pipeline.run(
-            source, (*bus.sinks, supervisor), realtime=realtime and not source.info.live, stop=stop
+            source,
+            (*bus.sinks, supervisor, *extra),
+            realtime=realtime and not source.info.live,
+            stop=stop,
         )
         health.status = "stopping"
         supervisor.stopping(stop.signal_name or "end of source")

@@ -1,4 +1,4 @@
-"""Capture: frame sources behind one Protocol (video file, image folder, V4L2 camera, loop)."""
+"""Capture: frame sources behind one Protocol (video, MCAP recording, image folder, V4L2, loop)."""
 
 from roadgaze.capture.base import (
     FrameSource,
@@ -9,7 +9,8 @@ from roadgaze.capture.base import (
 )
 from roadgaze.capture.camera import CameraSource, camera_device
 from roadgaze.capture.files import IMAGE_SUFFIXES, ImageFolderSource, LoopingSource, VideoFileSource
-from roadgaze.capture.open import open_source
+from roadgaze.capture.mcap import McapSource, is_mcap
+from roadgaze.capture.open import open_file, open_source
 
 __all__ = [
     "IMAGE_SUFFIXES",
@@ -17,11 +18,14 @@ __all__ = [
     "FrameSource",
     "ImageFolderSource",
     "LoopingSource",
+    "McapSource",
     "SourceInfo",
     "SourceStatus",
     "VideoCaptureLike",
     "VideoFileSource",
     "as_bgr",
     "camera_device",
+    "is_mcap",
+    "open_file",
     "open_source",
 ]

@@ -7,6 +7,7 @@ from pathlib import Path
 from roadgaze.capture.base import FrameSource
 from roadgaze.capture.camera import CameraSource, camera_device
 from roadgaze.capture.files import ImageFolderSource, VideoFileSource
+from roadgaze.capture.mcap import McapSource, is_mcap
 from roadgaze.config import Config
 from roadgaze.errors import SourceError
 
@@ -14,7 +15,8 @@ from roadgaze.errors import SourceError
 def open_source(
     spec: str, config: Config | None = None, *, wait_for_camera: bool = False
 ) -> FrameSource:
-    """The frame source a user names: an existing file, a folder, `/dev/videoN` or an index.
+    """The frame source a user names: an existing file (a video or an MCAP recording), a folder,
+    `/dev/videoN` or an index.
 
     Raises `SourceError` when the string names none of these or the source cannot be opened;
     with `wait_for_camera` a camera that cannot be opened yet is waited for instead (its status
@@ -23,7 +25,7 @@ def open_source(
     config = config if config is not None else Config()
     path = Path(spec).expanduser()
     if path.is_file():
-        return VideoFileSource(path)
+        return open_file(path, config)
     if path.is_dir():
         return ImageFolderSource(path, fps=config.capture.fps)
     device = camera_device(spec)
@@ -33,3 +35,11 @@ def open_source(
         f"no video file, image folder or camera '{spec}'; pass an existing file or folder, "
         "/dev/videoN or a camera index"
     )
+
+
+def open_file(path: Path, config: Config | None = None) -> FrameSource:
+    """A file as a drive: an MCAP recording (by its magic bytes) or a video file."""
+    if is_mcap(path):
+        topic = config.record.camera_topic if config is not None else None
+        return McapSource(path, topic)
+    return VideoFileSource(path)

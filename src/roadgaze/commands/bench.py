@@ -79,6 +79,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--no-raw", action="store_true", help="skip the raw MediaPipe passes (no ratio_to_raw)"
     )
+    parser.add_argument("--record", action="store_true", help="add --repeat rounds of passes "
+                        "without a recorder, recording records and alerts to MCAP, and camera "
+                        "frames too; report the cost per frame (roadgaze[foxglove])")  # fmt: skip
     parser.set_defaults(handler=run)
 
 
@@ -129,6 +132,10 @@ def run(args: argparse.Namespace, config: Config) -> int:
     check_seconds("--loop-seconds", args.loop_seconds)
     if args.repeat < 1:
         raise ConfigError(f"--repeat must be at least 1, found {args.repeat}")
+    if args.record:
+        from roadgaze.outputs.foxglove import require_foxglove
+
+        require_foxglove("bench --record")
     rss_start_mb = resident_mb()
     with open_bench_source(args, config) as first_source:
         live = first_source.info.live
@@ -150,6 +157,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
             raw_passes.append(raw_pass(args, config, number + 1, args.repeat + 1))
     if args.latency:
         latency = latency_pass(args, config)
+    recording = recording_cost(args, config) if args.record else None
     if timings.count == 0:
         frames = passes[0].summary.frames
         raise ConfigError(
@@ -157,6 +165,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
             "lower --warmup"
         )
     result = bench_result(args.source, passes, timings, raw_passes, latency)
+    if recording is not None:
+        result["recording"] = recording
     if memory is not None:
         growth = memory.growth_mb
         result["memory"] = {
@@ -224,6 +234,17 @@ def latency_pass(args: argparse.Namespace, config: Config) -> LatencyPass:
         rig.probe.wait_for_count(published, 5.0)
         latency = rig.probe.result(published, skip_first=args.warmup)
     return LatencyPass(latency, timings.stats())
+
+
+def recording_cost(args: argparse.Namespace, config: Config) -> dict[str, Any]:
+    """`--record`: the recording passes (`roadgaze.benchmark.recording`)."""
+    from roadgaze.benchmark.recording import recording_cost as cost
+
+    def run_pass(sinks: Sequence[Any], timings: StageTimings) -> tuple[RunSummary, float | None]:
+        result = pipeline_pass(args, config, list(sinks), timings)
+        return result.summary, result.cpu_ms_per_frame
+
+    return cost(run_pass, config, args.source, args.repeat, args.warmup)
 
 
 def _round(value: float | None, digits: int) -> float | None:
@@ -363,6 +384,10 @@ def format_result(result: dict[str, Any]) -> str:
             f"{latency['to_publish_p99_ms']} ms, Zenoh delivery p50 {latency['delivery_p50_ms']} / "
             f"p99 {latency['delivery_p99_ms']} ms"
         )
+    if "recording" in result:
+        from roadgaze.benchmark.recording import format_recording
+
+        lines += format_recording(result["recording"])
     if "memory" in result:
         memory = result["memory"]
         lines.append(

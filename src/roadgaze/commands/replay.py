@@ -69,6 +69,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--plot", type=Path, metavar="FILE", help="PNG of raw and smoothed yaw over time"
     )
     parser.add_argument(
+        "--mcap",
+        type=Path,
+        metavar="FILE",
+        help="MCAP recording for Foxglove: camera frames, annotations, records, alerts, state "
+        "and logs ([record] settings; docs/foxglove.md; needs roadgaze[foxglove])",
+    )
+    parser.add_argument(
         "--realtime",
         action="store_true",
         help="pace the replay at the source's own rate (default: as fast as possible)",
@@ -167,7 +174,7 @@ def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) ->
         log.warning("replay %s: %s", args.source, status.message)
     if status.frames_dropped:
         log.warning("replay %s: %d frames dropped", args.source, status.frames_dropped)
-    for name in ("out", "csv", "plot", "annotate"):
+    for name in ("out", "csv", "plot", "annotate", "mcap"):
         value = getattr(args, name)
         if value is not None and value != "-":
             log_written(value)
@@ -183,11 +190,16 @@ def run(args: argparse.Namespace, config: Config) -> int:
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
+    outputs = {"--out": args.out, "--csv": args.csv, "--plot": args.plot}
     check_output_paths(
         {"VIDEO": args.source},
-        {"--out": args.out, "--csv": args.csv, "--plot": args.plot, "--annotate": args.annotate},
-        {"--plot": PLOT_SUFFIXES, "--annotate": tuple(FOURCC_BY_SUFFIX)},
+        {**outputs, "--annotate": args.annotate, "--mcap": args.mcap},
+        {"--plot": PLOT_SUFFIXES, "--annotate": tuple(FOURCC_BY_SUFFIX), "--mcap": (".mcap",)},
     )
+    if args.mcap is not None:
+        from roadgaze.outputs.foxglove import require_foxglove
+
+        require_foxglove("--mcap")
     config = with_zenoh_args(config, args)
     stats = ReplayStats()
     with ExitStack() as stack:
@@ -197,6 +209,14 @@ def run(args: argparse.Namespace, config: Config) -> int:
         stack.callback(detector.close)
         bus = stack.enter_context(bus_outputs(config, args.source, args.publish, log_name=log.name))
         sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack, config)]
+        if args.mcap is not None:
+            from roadgaze.outputs.foxglove.open import replay_recorder
+
+            flat_out = not args.realtime and not source.info.live
+            recorder = replay_recorder(
+                config, args.source, args.mcap, bus.health.state_json, block_on_images=flat_out
+            )
+            sinks.append(stack.enter_context(recorder))
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
     fill_offline(args, config)

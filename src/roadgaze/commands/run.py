@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
 from roadgaze.commands.options import add_zenoh_options, common_options, with_zenoh_args
@@ -28,6 +29,19 @@ def register(subparsers: Any) -> None:
         action="store_true",
         help="process a file as fast as possible instead of at its own frame rate",
     )
+    parser.add_argument(
+        "--record",
+        type=Path,
+        metavar="DIR",
+        help="record MCAP segments into DIR, rotated by size and age, the folder kept under "
+        "record.max_disk_mb (camera frames only with record.images=true; docs/foxglove.md)",
+    )
+    parser.add_argument(
+        "--foxglove",
+        metavar="[HOST:]PORT",
+        help="serve the live view to the Foxglove app on PORT (loopback unless HOST is given: "
+        "the stream shows the driver's face)",
+    )
     add_zenoh_options(parser)
     parser.set_defaults(handler=run)
 
@@ -35,6 +49,10 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.service.signals import StopFlag, signal_handlers
 
+    if args.record is not None or args.foxglove is not None:
+        from roadgaze.outputs.foxglove import require_foxglove
+
+        require_foxglove("--record" if args.record is not None else "--foxglove")
     stop = StopFlag()
     # Handlers before the heavy imports: as PID 1 of a container, a SIGTERM arriving while
     # they load would otherwise be ignored (PID 1 has no default action).
@@ -47,4 +65,6 @@ def run(args: argparse.Namespace, config: Config) -> int:
             stop=stop,
             realtime=not args.no_realtime,
             handle_signals=False,
+            record_dir=args.record,
+            foxglove=args.foxglove,
         )

@@ -1,6 +1,7 @@
 """Configuration: pydantic sections from defaults, a TOML file, the environment and `--set`."""
 
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
+from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section
 from roadgaze.config.settings import (
     ENV_PREFIX,
@@ -40,6 +41,7 @@ __all__ = [
     "ModelConfig",
     "MonitorConfig",
     "PoseConfig",
+    "RecordConfig",
     "Section",
     "SmoothingConfig",
     "ZenohConfig",

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, Literal, Self
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
+from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section as _Section
 from roadgaze.config.zenoh import ZenohConfig
 from roadgaze.errors import ConfigError
@@ -289,6 +290,7 @@ class Config(_Section):
     monitor: MonitorConfig = MonitorConfig()
     zenoh: ZenohConfig = ZenohConfig()
     logging: LoggingConfig = LoggingConfig()
+    record: RecordConfig = RecordConfig()
 
 
 def _parse_value(text: str, origin: str) -> Any:

@@ -23,9 +23,10 @@ from roadgaze.errors import ConfigError
 
 VIDEO_SUFFIXES = frozenset(
     {".mp4", ".m4v", ".mov", ".avi", ".mkv", ".webm", ".mpg", ".mpeg", ".ts", ".mts", ".wmv"}
-    | {".flv", ".gif"}
+    | {".flv", ".gif", ".mcap"}
 )
-"""File suffixes (any case) taken as videos when a folder is searched."""
+"""File suffixes (any case) taken as drives when a folder is searched (`.mcap`: a recording with a
+camera channel, `roadgaze.capture.McapSource`)."""
 
 MANIFEST_COLUMNS = ("path", "drive_id", "driver_id", "vehicle_id", "start_time")
 """The columns a manifest may have; `path` is required, relative paths are relative to the

@@ -172,7 +172,7 @@ def process_drive(task: DriveTask) -> DriveResult:
 
 
 def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> DriveResult:
-    from roadgaze.capture import VideoFileSource
+    from roadgaze.capture import open_file
     from roadgaze.pipeline import Pipeline, create_detector
 
     drive, config = task.drive, task.config
@@ -184,7 +184,7 @@ def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> 
         "start_time": drive.start_time,
     }
     with ExitStack() as stack:
-        source = stack.enter_context(VideoFileSource(drive.path))
+        source = stack.enter_context(open_file(drive.path, config))
         detector = create_detector(config)
         stack.callback(detector.close)
         startup_s = time.perf_counter() - started

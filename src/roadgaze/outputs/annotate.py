@@ -181,6 +181,24 @@ def _roll_frame(features: FaceFeatures) -> _RollFrame:
     return _RollFrame(angle_rad=roll, pivot=pivot, offset_px=mid_there - mid_here)
 
 
+def face_lines_px(features: FaceFeatures) -> tuple[tuple[str, npt.NDArray[np.float64]], ...]:
+    """The face's two boundaries and its centre line in image pixels: (`left`, `right` or
+    `centre`, their two ends as a 2x2 array of x, y). Each is vertical in the roll-removed frame
+    and reaches 15 % of the face box's height beyond the box at both ends."""
+    _, y_min, _, y_max = features.box_px
+    margin = 0.15 * (y_max - y_min)
+    top, bottom = y_min - margin, y_max + margin
+    roll_frame = _roll_frame(features)
+    lines = (
+        ("left", features.x_left_px),
+        ("right", features.x_right_px),
+        ("centre", features.x_center_px),
+    )
+    return tuple(
+        (name, roll_frame.to_image(np.array([[x_px, top], [x_px, bottom]]))) for name, x_px in lines
+    )
+
+
 def annotate(
     image: npt.NDArray[np.uint8],
     record: FrameRecord,
@@ -202,17 +220,9 @@ def annotate(
         cv2.rectangle(
             canvas, (round(x_min), round(y_min)), (round(x_max), round(y_max)), (90, 90, 90), 1
         )
-        margin = 0.15 * (y_max - y_min)
-        top, bottom = y_min - margin, y_max + margin
-        roll_frame = _roll_frame(features)
-        lines = (
-            (features.x_left_px, (0, 200, 255)),
-            (features.x_right_px, (0, 200, 255)),
-            (features.x_center_px, (0, 255, 0)),
-        )
-        for x_px, colour in lines:
-            ends = roll_frame.to_image(np.array([[x_px, top], [x_px, bottom]]))
+        for name, ends in face_lines_px(features):
             (x0, y0), (x1, y1) = ends
+            colour = (0, 255, 0) if name == "centre" else (0, 200, 255)
             cv2.line(canvas, (round(x0), round(y0)), (round(x1), round(y1)), colour, thickness)
     draw_eyes(canvas, record, scale)
     gauge_width = _draw_gauge(canvas, sample, scale)

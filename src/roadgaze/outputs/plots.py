@@ -14,7 +14,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -111,9 +111,13 @@ def label_rows(spans: Sequence[tuple[float, float]], gap: float = 0.0) -> list[i
     return rows
 
 
+Degrees = TypeVar("Degrees", float, FloatArray)
+"""One frame's angle (a float) or every frame's (an array): the band functions take either."""
+
+
 def road_bands_deg(
-    neutral_deg: FloatArray, monitor: MonitorConfig
-) -> tuple[tuple[FloatArray, FloatArray], tuple[FloatArray, FloatArray]]:
+    neutral_deg: Degrees, monitor: MonitorConfig
+) -> tuple[tuple[Degrees, Degrees], tuple[Degrees, Degrees]]:
     """The monitor's yaw limits per frame, degrees: the road-ahead band (neutral +-
     `road_half_width_deg`, left on crossing it) and the narrower band a head off road must come
     back into (neutral +- (`road_half_width_deg` - `hysteresis_deg`))."""
@@ -123,8 +127,8 @@ def road_bands_deg(
 
 
 def road_pitch_bands_deg(
-    neutral_deg: FloatArray, monitor: MonitorConfig
-) -> tuple[tuple[FloatArray, FloatArray], tuple[FloatArray, FloatArray]]:
+    neutral_deg: Degrees, monitor: MonitorConfig
+) -> tuple[tuple[Degrees, Degrees], tuple[Degrees, Degrees]]:
     """The road zone's pitch limits per frame, degrees: left beyond neutral + `road_pitch_deg`
     grown by `hysteresis_deg`, entered again within neutral + `road_pitch_deg`."""
     low, high = monitor.road_pitch_deg
@@ -133,6 +137,24 @@ def road_pitch_bands_deg(
         neutral_deg + low,
         neutral_deg + high,
     )
+
+
+TIMER_THRESHOLDS: tuple[tuple[str, str, str], ...] = (
+    ("long_distraction_s", "long distraction", "tab:orange"),
+    ("critical_distraction_s", "critical", "tab:red"),
+    ("vats_threshold_s", "VATS", "tab:purple"),
+    ("microsleep_s", "microsleep", "tab:brown"),
+    ("sleep_s", "sleep", "tab:brown"),
+)
+"""The timers' thresholds drawn with them: the monitor setting, its label, its colour."""
+
+
+def timer_thresholds(monitor: MonitorConfig) -> list[tuple[str, float, str, str]]:
+    """(setting, seconds, label, colour) of each threshold in `TIMER_THRESHOLDS`."""
+    return [
+        (key, float(getattr(monitor, key)), label, colour)
+        for key, label, colour in TIMER_THRESHOLDS
+    ]
 
 
 def _runs(flags: Sequence[bool]) -> list[tuple[int, int]]:
@@ -310,14 +332,7 @@ class YawPlot(ClosesOnExit):
     def _draw_timers(self, axes: Any) -> None:
         if self.monitor is None:
             return
-        thresholds = (
-            (self.monitor.long_distraction_s, "long distraction", "tab:orange"),
-            (self.monitor.critical_distraction_s, "critical", "tab:red"),
-            (self.monitor.vats_threshold_s, "VATS", "tab:purple"),
-            (self.monitor.microsleep_s, "microsleep", "tab:brown"),
-            (self.monitor.sleep_s, "sleep", "tab:brown"),
-        )
-        for seconds, name, colour in thresholds:
+        for _, seconds, name, colour in timer_thresholds(self.monitor):
             axes.axhline(seconds, color=colour, lw=0.7, ls=":")
             axes.annotate(f"{name} {seconds:g} s", (1.0, seconds),
                           xycoords=("axes fraction", "data"), ha="right", va="bottom",

@@ -64,6 +64,8 @@ class Health:
         self.recent_alerts: deque[Alert] = deque(maxlen=RECENT_ALERTS)
         self.last: FrameRecord | None = None
         self._initial_verdict = verdict_of(config.monitor, initial_state(config.monitor))
+        self.problem_checks: list[Callable[[], str | None]] = []
+        """Other parts' problems (a recording that stopped), asked at each state message."""
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         self.last = record
@@ -123,6 +125,7 @@ class Health:
                 f"eyes unavailable for {eyes.unavailable_s:.0f} s ({eyes.reason or 'unknown'}): "
                 "monitoring on head pose only"
             )
+        problems.extend(problem for check in self.problem_checks if (problem := check()))
         status = self.status
         if status in ("starting", "running") and problems:
             status = "degraded"

@@ -1,0 +1,208 @@
+"""A recording cut short (`kill -9`, a power loss, a full disk) made whole again.
+
+An MCAP file is written as a header, then records (schemas, channels, metadata and chunks of
+messages), and at the close a summary with the chunk index and a footer. Cut short, it lacks the
+summary and footer, and its last chunk may be half written. `recover_mcap` reads the records in
+order with the `mcap` reader until the first one that is incomplete or fails its CRC, and
+writes what it read into a new, indexed file: every message of every complete chunk is kept;
+lost are the chunk that was being written (at most `record.flush_s` of data: the writer writes
+and syncs its open chunk that often) and anything after a damaged record.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from mcap.records import Channel, Chunk, Header, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader, breakup_chunk
+from mcap.writer import CompressionType, Writer
+
+from roadgaze.errors import RoadgazeError
+from roadgaze.outputs.foxglove.targets import OPEN_SUFFIX
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, slots=True)
+class Recovery:
+    """What a recovery kept and what it could not."""
+
+    source: Path
+    path: Path
+    messages: int
+    chunks: int
+    first_log_time_ns: int | None
+    last_log_time_ns: int | None
+    bytes_read: int
+    """Bytes of the source up to the end of its last complete record."""
+    bytes_lost: int
+    """Bytes after that: the half-written chunk (or summary) that cannot be read."""
+    stopped_because: str
+    """Why reading stopped: `end of file`, or the error of the first unreadable record."""
+
+    def describe(self) -> str:
+        span = ""
+        if self.first_log_time_ns is not None and self.last_log_time_ns is not None:
+            span = f" ({(self.last_log_time_ns - self.first_log_time_ns) / 1e9:.1f} s)"
+        kept = f"{self.messages} messages in {self.chunks} chunks{span} kept"
+        if self.stopped_because == "end of file":
+            return f"{kept}; the file was complete"
+        if self.bytes_lost == 0:
+            return f"{kept}; it ended after its last complete chunk (nothing half written)"
+        return (
+            f"{kept}; lost the {self.bytes_lost} bytes of the chunk being written "
+            f"({self.stopped_because})"
+        )
+
+
+class _Counting:
+    """A binary stream that counts what was read (where the last good record ended)."""
+
+    def __init__(self, stream: object) -> None:
+        self._stream = stream
+        self.position = 0
+
+    def read(self, size: int = -1) -> bytes:
+        data: bytes = self._stream.read(size)  # type: ignore[attr-defined]
+        self.position += len(data)
+        return data
+
+
+def _records(stream: _Counting) -> Iterator[tuple[object, int]]:
+    """(record, end offset) of each record read in order; stops at the first unreadable one by
+    raising it to the caller."""
+    reader = StreamReader(stream, skip_magic=False, emit_chunks=True)  # type: ignore[arg-type]
+    for record in reader.records:
+        yield record, stream.position
+
+
+def recover_mcap(source: Path, path: Path) -> Recovery:
+    """Write every readable message of `source` (an MCAP file, complete or cut short) into a
+    new, indexed MCAP `path` (written beside it, then renamed). Raises `RoadgazeError` when
+    `source` is not an MCAP file or holds no readable record."""
+    size = source.stat().st_size
+    temporary = path.with_name(f".{path.name}.recovering")
+    schemas: dict[int, int] = {}
+    channels: dict[int, int] = {}
+    messages = chunks = 0
+    first_ns: int | None = None
+    last_ns: int | None = None
+    good_end = 0
+    stopped = "end of file"
+    try:
+        with source.open("rb") as raw, temporary.open("wb") as out:
+            stream = _Counting(raw)
+            writer = Writer(out, compression=CompressionType.ZSTD)
+            started = False
+            iterator = _records(stream)
+            while True:
+                try:
+                    item = next(iterator, None)
+                    if item is None:  # the footer and the closing magic read
+                        good_end = stream.position
+                        break
+                    record, end = item
+                    inner = (
+                        list(breakup_chunk(record, True)) if isinstance(record, Chunk) else [record]
+                    )
+                except Exception as exc:  # the first unreadable record ends the recovery
+                    stopped = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+                    break
+                if isinstance(record, Header):
+                    writer.start(profile=record.profile, library=record.library)
+                    started = True
+                    good_end = end
+                    continue
+                if not started:
+                    raise RoadgazeError(f"{source} is not an MCAP recording (no header)")
+                for entry in inner:
+                    if isinstance(entry, Schema) and entry.id not in schemas:
+                        schemas[entry.id] = writer.register_schema(
+                            entry.name, entry.encoding, entry.data
+                        )
+                    elif isinstance(entry, Channel) and entry.id not in channels:
+                        channels[entry.id] = writer.register_channel(
+                            entry.topic,
+                            entry.message_encoding,
+                            schemas.get(entry.schema_id, 0),
+                            dict(entry.metadata),
+                        )
+                    elif isinstance(entry, Message) and entry.channel_id in channels:
+                        writer.add_message(
+                            channels[entry.channel_id],
+                            entry.log_time,
+                            entry.data,
+                            entry.publish_time,
+                            entry.sequence,
+                        )
+                        messages += 1
+                        first_ns = (
+                            entry.log_time if first_ns is None else min(first_ns, entry.log_time)
+                        )
+                        last_ns = (
+                            entry.log_time if last_ns is None else max(last_ns, entry.log_time)
+                        )
+                    elif isinstance(entry, Metadata):
+                        writer.add_metadata(entry.name, dict(entry.metadata))
+                chunks += isinstance(record, Chunk)
+                good_end = end
+            if not started:
+                raise RoadgazeError(f"{source} is not an MCAP recording ({stopped})")
+            writer.finish()  # type: ignore[no-untyped-call]
+            out.flush()
+            os.fsync(out.fileno())
+        temporary.replace(path)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            temporary.unlink()
+        raise RoadgazeError(f"cannot recover {source}: {exc.strerror or exc}") from None
+    except BaseException:
+        with contextlib.suppress(OSError):
+            temporary.unlink()
+        raise
+    return Recovery(
+        source=source,
+        path=path,
+        messages=messages,
+        chunks=chunks,
+        first_log_time_ns=first_ns,
+        last_log_time_ns=last_ns,
+        bytes_read=good_end,
+        bytes_lost=max(0, size - good_end),
+        stopped_because=stopped,
+    )
+
+
+def recovered_name(part: Path) -> Path:
+    """`NAME.mcap.part` -> `NAME.mcap`; any other name gets `.recovered.mcap`."""
+    if part.name.endswith(f".mcap{OPEN_SUFFIX}"):
+        return part.with_name(part.name.removesuffix(OPEN_SUFFIX))
+    return part.with_name(f"{part.stem}.recovered.mcap")
+
+
+def recover_parts(folder: Path, pattern: str) -> list[Recovery]:
+    """Recover every open segment (`pattern`) a killed run left in `folder`, each logged; a part
+    that cannot be recovered is renamed `.unreadable` and left (logged)."""
+    done: list[Recovery] = []
+    for part in sorted(folder.glob(pattern)):
+        target = recovered_name(part)
+        try:
+            recovery = recover_mcap(part, target)
+        except RoadgazeError as exc:
+            part.replace(part.with_name(f"{part.name}.unreadable"))
+            log.warning("record: cannot recover %s, left as .unreadable: %s", part.name, exc)
+            continue
+        part.unlink()
+        done.append(recovery)
+        log.warning(
+            "record: recovered %s left open by an interrupted run into %s: %s",
+            part.name,
+            target.name,
+            recovery.describe(),
+        )
+    return done

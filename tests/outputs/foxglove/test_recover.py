@@ -83,7 +83,10 @@ def test_kill_9_leaves_closed_segments_readable_and_the_open_one_recoverable(
     for segment in frames:
         assert segment == list(range(segment[0], segment[0] + len(segment)))
     recovered = recover_mcap(part, tmp_path / "recovered.mcap")
-    assert recovered.messages > 0 and recovered.stopped_because != "end of file"
+    # The kill may land between two chunks (nothing half-written: "end of file") or inside one
+    # (the half-written chunk is what is lost); either way the part has no footer of its own.
+    assert recovered.messages > 0
+    assert recovered.bytes_read + recovered.bytes_lost == part.stat().st_size
     part_frames = frames_of(recovered.path)
     everything = [frame for segment in [*frames, part_frames] for frame in segment]
     assert everything == list(range(everything[0], everything[0] + len(everything)))

@@ -29,7 +29,12 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "src"))
 
 from roadgaze.config import Config  # noqa: E402
-from roadgaze.evaluation import estimate_images, load_ground_truth  # noqa: E402
+from roadgaze.evaluation import (  # noqa: E402
+    GroundTruth,
+    ImageEstimate,
+    estimate_images,
+    load_ground_truth,
+)
 from roadgaze.evaluation.full_range_cv import cross_validate_full_range  # noqa: E402
 from roadgaze.evaluation.stats import separation_auc  # noqa: E402
 from roadgaze.landmarks.features import FACE_OVAL, remove_roll  # noqa: E402
@@ -64,19 +69,20 @@ def _line_deg(x: np.ndarray, z: np.ndarray, right: int, left: int) -> float:
     return math.degrees(math.atan2(float(z[left] - z[right]), float(x[left] - x[right])))
 
 
-def cues_of(estimate: object) -> list[float]:
+def cues_of(e: ImageEstimate) -> list[float]:
     """The candidate cues of one face, signed so that they grow with the turn either way."""
-    e = estimate
-    up = remove_roll(e.landmarks_px, e.roll_deg)  # type: ignore[attr-defined]
+    assert e.landmarks_px is not None and e.roll_deg is not None
+    assert e.x_left_px is not None and e.x_right_px is not None and e.x_center_px is not None
+    up = remove_roll(e.landmarks_px, e.roll_deg)
     x, y = up[:, 0], up[:, 1]
-    z = np.asarray(e.landmarks_px[:, 2], dtype=np.float64)  # type: ignore[attr-defined]
-    left, right, centre = e.x_left_px, e.x_right_px, e.x_center_px  # type: ignore[attr-defined]
+    z = np.asarray(e.landmarks_px[:, 2], dtype=np.float64)
+    left, right, centre = e.x_left_px, e.x_right_px, e.x_center_px
     side = 1.0 if centre >= 0.5 * (left + right) else -1.0
     height = math.hypot(x[152] - x[10], y[152] - y[10])
     lines = [_line_deg(x, z, a, b) for a, b in CONTOUR_PAIRS]
     oval = np.array(FACE_OVAL)
     return [
-        side * (e.mediapipe_yaw_deg or math.nan),  # type: ignore[attr-defined]
+        side * (e.mediapipe_yaw_deg or math.nan),
         side * lines[0],
         side * _line_deg(x, z, 33, 263),
         side * float(np.median(lines)),
@@ -149,8 +155,6 @@ def main() -> int:
         ]
         aucs = [max(a, 1.0 - a) for a in aucs]  # a cue may fall with the turn
         print(f"{name:<34} {cells}  " + "  ".join(f"{a:.3f}" for a in aucs))
-
-    from roadgaze.evaluation import GroundTruth, ImageEstimate
 
     truths = [
         GroundTruth(str(i), float(y), 0.0, str(s))

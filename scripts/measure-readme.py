@@ -211,6 +211,15 @@ def markdown(
                 f"| {label} | {bold}{stats['mae_deg']:.2f}{bold} | {stats['rmse_deg']:.2f} | "
                 f"{stats['median_abs_error_deg']:.2f} | {100 * stats['detection_rate']:.1f}% |"
             )
+        cross = eval_run.get("cross_validation")
+        if cross is not None:
+            ranges = cross["ranges"]
+            lines += [
+                "",
+                "With the blend's two constants re-fitted leaving each subject out, the service's "
+                f"yaw gives {ranges['abs_yaw_le_60']['service_cv']['mae_deg']:.2f} within +-60 "
+                f"and {ranges['all']['service_cv']['mae_deg']:.2f} over all poses.",
+            ]
     return "\n".join(lines)
 
 

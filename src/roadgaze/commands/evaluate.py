@@ -19,11 +19,13 @@ def register(subparsers: Any) -> None:
         parents=[common_options()],
         help="score the yaw models against a data set's ground_truth.csv",
         description="Estimate the pose on every image listed in DATASET_DIR/ground_truth.csv "
-        "(columns file,yaw_deg[,pitch_deg]; rows with |pitch_deg| = 90 are skipped) and print "
-        "MAE, RMSE, median error and detection rate per yaw model, for the service's yaw and for "
-        "MediaPipe's own yaw, for |yaw| <= 60 deg, for all rows, and per 15 deg bin; with pitch "
-        "labels also the pitch's rank correlation and mean error per tilt and the lap "
-        "classification (tilt -60 against |tilt| <= 15). Stills take neutral 0. The report goes "
+        "(columns file,yaw_deg[,pitch_deg][,subject]; rows with |pitch_deg| = 90 are skipped) and "
+        "print MAE, RMSE, median error and detection rate per yaw model, for the service's yaw and "
+        "for MediaPipe's own yaw, for |yaw| <= 60 deg, for all rows, and MAE and bias per 15 deg "
+        "bin; with a subject column also the full-range blend with its constants re-fitted "
+        "leaving each subject out; with pitch labels also the pitch's rank correlation and mean "
+        "error per tilt and the lap classification (tilt -60 against |tilt| <= 15). Stills take "
+        "neutral 0. The report goes "
         "to stdout, the progress bar and the log to stderr.",
     )
     parser.add_argument("dataset", type=Path, metavar="DATASET_DIR")

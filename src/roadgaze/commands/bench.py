@@ -82,6 +82,12 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--record", action="store_true", help="add --repeat rounds of passes "
                         "without a recorder, recording records and alerts to MCAP, and camera "
                         "frames too; report the cost per frame (roadgaze[foxglove])")  # fmt: skip
+    parser.add_argument(
+        "--engines",
+        action="store_true",
+        help="compare the landmark engines: --repeat rounds of a raw FaceLandmarker pass and one "
+        "pipeline pass per engine (litert, mediapipe), interleaved; medians and the load average",
+    )
     parser.set_defaults(handler=run)
 
 
@@ -120,6 +126,8 @@ class PassResult:
     """After the warm-up (`ThroughputProbe`)."""
     cpu_ms_per_frame: float | None
     median_interval_ms: float | None
+    engine: str | None = None
+    """The landmark engine that ran."""
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
@@ -136,6 +144,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
         from roadgaze.outputs.foxglove import require_foxglove
 
         require_foxglove("bench --record")
+    if args.engines:
+        return engines_run(args, config)
     rss_start_mb = resident_mb()
     with open_bench_source(args, config) as first_source:
         live = first_source.info.live
@@ -181,6 +191,29 @@ def run(args: argparse.Namespace, config: Config) -> int:
     return 0
 
 
+def engines_run(args: argparse.Namespace, config: Config) -> int:
+    """`--engines`: both engines and raw FaceLandmarker, interleaved (`benchmark.engines`)."""
+    from roadgaze.benchmark.engines import EnginePass, compare_engines, format_engines
+    from roadgaze.pipeline import StageTimings
+
+    def engine_pass(name: str) -> EnginePass:
+        landmarks = config.landmarks.model_copy(update={"engine": name})
+        timings = StageTimings(skip_first=args.warmup)
+        result = pipeline_pass(
+            args, config.model_copy(update={"landmarks": landmarks}), [], timings
+        )
+        stages = {stage: (s.median_ms, s.p99_ms) for stage, s in timings.stats().items()}
+        return EnginePass(result.fps, result.cpu_ms_per_frame, stages, result.engine or name)
+
+    raws = iter(range(1, args.repeat + 2))
+    result = compare_engines(
+        args.repeat, engine_pass, lambda: raw_pass(args, config, next(raws), args.repeat + 1)
+    )
+    result = {"source": args.source, "default_engine": config.landmarks.engine, **result}
+    print(json.dumps(result) if args.json else "\n".join(format_engines(result)))
+    return 0
+
+
 def pipeline_pass(
     args: argparse.Namespace,
     config: Config,
@@ -202,7 +235,11 @@ def pipeline_pass(
         log.info("pipeline pass over %s%s", args.source, " at its frame rate" if realtime else "")
         summary = pipeline.run(source, [*sinks, throughput], timings=timings, realtime=realtime)
     return PassResult(
-        summary, throughput.fps, throughput.cpu_ms_per_frame, throughput.median_interval_ms
+        summary,
+        throughput.fps,
+        throughput.cpu_ms_per_frame,
+        throughput.median_interval_ms,
+        getattr(detector, "engine", None),
     )
 
 

@@ -50,6 +50,7 @@ BLENDSHAPE_LANDMARKS = (
     473, 474, 475, 476, 477,
 )  # fmt: skip
 """The landmarks the blendshape model reads, as x, y pixels (`face_blendshapes_graph.cc`)."""
+BLENDSHAPE_INDEX = np.array(BLENDSHAPE_LANDMARKS, np.intp)
 BLENDSHAPE_NAMES = (
     "_neutral", "browDownLeft", "browDownRight", "browInnerUp", "browOuterUpLeft",
     "browOuterUpRight", "cheekPuff", "cheekSquintLeft", "cheekSquintRight", "eyeBlinkLeft",
@@ -132,6 +133,8 @@ class _Model:
 
 INTER_TAB_SIZE = 32
 """Sub-pixel steps of OpenCV's fixed-point bilinear warp (INTER_BITS = 5)."""
+MAP_LIMIT = 1048000.0
+"""Source positions (in 1/32 px) beyond this are clipped, so the whole pixels fit in int16."""
 
 
 class Warper:
@@ -141,9 +144,9 @@ class Warper:
 
     def __init__(self, side_px: int, border: int) -> None:
         self.side_px, self._border = side_px, border
-        steps = np.arange(side_px, dtype=np.float64)
-        self._across, self._down = steps[None, :], steps[:, None]
         self._x, self._y, self._w = (np.empty((side_px, side_px)) for _ in range(3))
+        self._across = np.arange(side_px, dtype=np.float64)[None, :]
+        self._down = np.arange(side_px, dtype=np.float64)[:, None]
         self._ix, self._iy = (
             np.empty((side_px, side_px), np.int32),
             np.empty((side_px, side_px), np.int32),
@@ -152,11 +155,12 @@ class Warper:
         self._fraction = np.empty((side_px, side_px), np.uint16)
         self._out = np.empty((side_px, side_px, 3), np.uint8)
 
-    def _source(self, out: npt.NDArray[np.float64], row: npt.NDArray[np.float64]) -> None:
-        """out[y, x] = row[0] x + row[1] y + row[2]."""
-        np.multiply(self._down, row[1], out=out[:, :1])
-        out[:, :1] += row[2]
-        np.add(out[:, :1], self._across * row[0], out=out)
+    def _scaled_source(self, out: npt.NDArray[np.float64], row: npt.NDArray[np.float64]) -> None:
+        """out[y, x] = 32 (row[0] x + row[1] y + row[2]) in one pass (times 32: exact in binary
+        floating point, so the same doubles as scaling afterwards)."""
+        across = self._across * (INTER_TAB_SIZE * row[0])
+        down = self._down * (INTER_TAB_SIZE * row[1]) + INTER_TAB_SIZE * row[2]
+        np.add(down, across, out=out)
 
     def warp(
         self, rgb: npt.NDArray[np.uint8], roi: tuple[float, float, float, float, float]
@@ -179,19 +183,20 @@ class Warper:
         target = np.array([[0, side], [0, 0], [side, 0], [side, side]], np.float32)
         inverse = np.linalg.inv(cv2.getPerspectiveTransform(corners, target))
         x, y, w = self._x, self._y, self._w
-        self._source(x, inverse[0])
-        self._source(y, inverse[1])
         # The map is affine up to rounding (terms below 1e-18 leave w = 1 exactly in doubles).
         if abs(inverse[2, 0]) < 1e-18 and abs(inverse[2, 1]) < 1e-18:
-            x *= INTER_TAB_SIZE / inverse[2, 2]
-            y *= INTER_TAB_SIZE / inverse[2, 2]
+            self._scaled_source(x, inverse[0] / inverse[2, 2])
+            self._scaled_source(y, inverse[1] / inverse[2, 2])
         else:
-            self._source(w, inverse[2])
+            self._scaled_source(x, inverse[0])
+            self._scaled_source(y, inverse[1])
+            self._scaled_source(w, inverse[2])
             np.divide(INTER_TAB_SIZE, w, out=w, where=w != 0)
             x *= w
             y *= w
         for value, rounded in ((x, self._ix), (y, self._iy)):
-            np.clip(value, -1048000.0, 1048000.0, out=value)
+            if value.min() < -MAP_LIMIT or value.max() > MAP_LIMIT:
+                np.clip(value, -MAP_LIMIT, MAP_LIMIT, out=value)
             np.rint(value, out=value)
             rounded[...] = value
         np.right_shift(self._ix, 5, out=self._whole[..., 0], casting="unsafe")
@@ -324,7 +329,7 @@ class LiteRtFaceLandmarker:
         return transformation_matrix(points, size, self._face)
 
     def _scores(self, points: npt.NDArray[np.float32], size: tuple[int, int]) -> dict[str, float]:
-        subset = points[list(BLENDSHAPE_LANDMARKS), :2] * np.array(size, np.float32)
+        subset = points[BLENDSHAPE_INDEX, :2] * np.array(size, np.float32)
         scores = self._blendshapes.run(subset.astype(np.float32))[0].reshape(-1)
         return {name: float(score) for name, score in zip(BLENDSHAPE_NAMES, scores, strict=True)}
 

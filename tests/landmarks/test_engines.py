@@ -268,3 +268,12 @@ def test_missing_litert_runs_mediapipe_with_a_warning(
     with Landmarker(LandmarksConfig(), model_path, engine="litert") as detector:
         assert detector.engine == "mediapipe"
     assert "pip install 'ai-edge-litert==2.3.0'" in caplog.text
+
+
+def test_a_delegate_that_does_not_load_runs_mediapipe_with_a_warning(
+    model_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    config = LandmarksConfig(delegate="/nonexistent/libnpu_delegate.so")
+    with Landmarker(config, model_path, engine="litert") as detector:
+        assert detector.engine == "mediapipe"
+    assert "libnpu_delegate.so" in caplog.text and "running MediaPipe instead" in caplog.text

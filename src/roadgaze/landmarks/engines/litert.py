@@ -93,6 +93,20 @@ class Bundle:
         return cls(detector, landmarks, blendshapes, CanonicalFace.from_metadata(metadata))
 
 
+def _load_delegate(path: str) -> Any:
+    """LiteRT's external delegate from the library at `path`. The library is opened first:
+    LiteRT's own loader leaves a half-made object behind on a bad path, whose clean-up prints a
+    traceback. OSError for a library that cannot be opened or is no delegate."""
+    import ctypes
+
+    from ai_edge_litert import interpreter as litert
+
+    library = ctypes.CDLL(path)
+    if not hasattr(library, "tflite_plugin_create_delegate"):
+        raise OSError(f"{path} is not a LiteRT delegate (no tflite_plugin_create_delegate)")
+    return litert.load_delegate(path)
+
+
 class _Model:
     """One TFLite model on a LiteRT interpreter: write the input view, `invoke`, read outputs."""
 
@@ -104,9 +118,9 @@ class _Model:
             options["experimental_op_resolver_type"] = (
                 litert.OpResolverType.BUILTIN_WITHOUT_DEFAULT_DELEGATES
             )
-        elif delegate != "xnnpack":
-            options["experimental_delegates"] = [litert.load_delegate(delegate)]
         try:
+            if delegate not in DELEGATES:
+                options["experimental_delegates"] = [_load_delegate(delegate)]
             with filtered_native_stderr():
                 self._interpreter = litert.Interpreter(model_content=content, **options)
                 self._interpreter.allocate_tensors()

@@ -1,5 +1,4 @@
-"""Landmarks: the face landmarker (LiteRT or MediaPipe engine), the model file, face and eye
-features with roll removed."""
+"""Landmarks: the face landmarker and its engines, the model file, face and eye features."""
 
 from roadgaze.landmarks.candidates import CANDIDATE_CHOICES
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored, unmirror

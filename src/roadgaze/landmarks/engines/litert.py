@@ -169,12 +169,15 @@ class Warper:
         self._fraction = np.empty((side_px, side_px), np.uint16)
         self._out = np.empty((side_px, side_px, 3), np.uint8)
 
-    def _scaled_source(self, out: npt.NDArray[np.float64], row: npt.NDArray[np.float64]) -> None:
+    def _scaled_source(self, out: npt.NDArray[np.float64], row: npt.NDArray[np.float64]) -> bool:
         """out[y, x] = 32 (row[0] x + row[1] y + row[2]) in one pass (times 32: exact in binary
-        floating point, so the same doubles as scaling afterwards)."""
+        floating point, so the same doubles as scaling afterwards); True when every value lies
+        within +-`MAP_LIMIT` (the extremes of a sum of a row and a column)."""
         across = self._across * (INTER_TAB_SIZE * row[0])
         down = self._down * (INTER_TAB_SIZE * row[1]) + INTER_TAB_SIZE * row[2]
         np.add(down, across, out=out)
+        low, high = down.min() + across.min(), down.max() + across.max()
+        return bool(low >= -MAP_LIMIT and high <= MAP_LIMIT)
 
     def warp(
         self, rgb: npt.NDArray[np.uint8], roi: tuple[float, float, float, float, float]
@@ -199,8 +202,8 @@ class Warper:
         x, y, w = self._x, self._y, self._w
         # The map is affine up to rounding (terms below 1e-18 leave w = 1 exactly in doubles).
         if abs(inverse[2, 0]) < 1e-18 and abs(inverse[2, 1]) < 1e-18:
-            self._scaled_source(x, inverse[0] / inverse[2, 2])
-            self._scaled_source(y, inverse[1] / inverse[2, 2])
+            inside = self._scaled_source(x, inverse[0] / inverse[2, 2])
+            inside &= self._scaled_source(y, inverse[1] / inverse[2, 2])
         else:
             self._scaled_source(x, inverse[0])
             self._scaled_source(y, inverse[1])
@@ -208,8 +211,9 @@ class Warper:
             np.divide(INTER_TAB_SIZE, w, out=w, where=w != 0)
             x *= w
             y *= w
+            inside = False
         for value, rounded in ((x, self._ix), (y, self._iy)):
-            if value.min() < -MAP_LIMIT or value.max() > MAP_LIMIT:
+            if not inside:
                 np.clip(value, -MAP_LIMIT, MAP_LIMIT, out=value)
             np.rint(value, out=value)
             rounded[...] = value

@@ -102,6 +102,15 @@ class LandmarksConfig(_Section):
     mirror_average: bool = False
     """Also run the mirrored image and average the two measurements: exactly mirror-symmetric
     yaw and slightly better accuracy (docs/landmarks.md) for twice the landmarker time."""
+    engine: Literal["litert", "mediapipe"] = "mediapipe"
+    """What runs the face landmarker's models: `litert` (the three models on LiteRT with
+    MediaPipe's graph rebuilt around them, roadgaze.landmarks.engines) or `mediapipe` (its
+    FaceLandmarker, the reference). See docs/landmarks.md."""
+    threads: int = Field(default=1, ge=1, le=64)
+    """LiteRT's thread count per model (the `litert` engine; MediaPipe's API has none)."""
+    delegate: str = Field(default="xnnpack", min_length=1)
+    """LiteRT's delegate: `xnnpack` (its CPU kernels), `none` (builtin kernels, no delegate) or
+    the path of a delegate library, e.g. a vehicle NPU's from `ai-edge-litert-sdk-*`."""
 
 
 class CaptureConfig(_Section):

@@ -240,9 +240,9 @@ def _init_worker(
 ) -> None:
     from multiprocessing.util import Finalize
 
-    from roadgaze.landmarks.landmarker import MediaPipeLandmarker
+    from roadgaze.landmarks.landmarker import Landmarker
 
-    _worker["detector"] = MediaPipeLandmarker(landmarks_config, model_path, video=False)
+    _worker["detector"] = Landmarker(landmarks_config, model_path, video=False)
     _worker["constants"] = constants
     _worker["still"] = StillPose.from_config(config)
     # Runs when the worker leaves its loop, while MediaPipe's threads are still alive (an atexit
@@ -277,10 +277,10 @@ def estimate_images(
     bar = tqdm(total=len(jobs), desc=description, unit="img", disable=not progress, leave=False)
     try:
         if workers <= 1 or len(jobs) <= 1:
-            from roadgaze.landmarks.landmarker import MediaPipeLandmarker
+            from roadgaze.landmarks.landmarker import Landmarker
 
             still = StillPose.from_config(config)
-            with MediaPipeLandmarker(landmarks_config, model_path, video=False) as detector:
+            with Landmarker(landmarks_config, model_path, video=False) as detector:
                 for path, name in jobs:
                     yield estimate_image(detector, path, constants, name, still)
                     bar.update(1)

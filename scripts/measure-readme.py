@@ -8,8 +8,8 @@ Runs, with the `roadgaze` of the Python that runs this script:
 1. `roadgaze demo --out WORK/demo`, timed (the demo's own render/service/total split too);
 2. `roadgaze bench WORK/demo/drive.mp4 --json --repeat N --latency` on the demo's drive;
 3. `roadgaze synth --measure` (the service yaw's recovery on synthetic stills with exact truth);
-4. `roadgaze eval ../shared/data/pointing04-dev --workers 2 --report ...` when the evaluation
-   data sits beside the checkout (skipped, and said so, otherwise);
+4. `roadgaze eval $ROADGAZE_DATA/pointing04-dev --workers 2 --report ...` when the evaluation
+   set is there (or beside the development checkout; skipped, and said so, otherwise);
 5. with `--soak S`, `roadgaze bench WORK/demo/drive.mp4 --loop-seconds S --memory --no-raw`.
 
 The block names the machine (CPU, cores, memory, OS, Python, MediaPipe and OpenCV versions) and
@@ -33,7 +33,8 @@ from pathlib import Path
 from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
-POINTING04 = REPO.parent / "shared" / "data" / "pointing04-dev"
+DATA = Path(os.environ.get("ROADGAZE_DATA") or REPO.parent / "shared" / "data")
+POINTING04 = DATA / "pointing04-dev"
 METHOD_LABELS = {
     "cylindrical": "Cylindrical",
     "ellipsoidal": "Ellipsoidal",
@@ -197,7 +198,7 @@ def markdown(
         lines += [
             "",
             f"Accuracy on Pointing'04 subjects 1-10, \\|yaw\\| <= 60 (`roadgaze eval "
-            f"../shared/data/pointing04-dev --workers 2`, {eval_run['wall_s']:.0f} s):",
+            f"$ROADGAZE_DATA/pointing04-dev --workers 2`, {eval_run['wall_s']:.0f} s):",
             "",
             "| method | MAE (deg) | RMSE | median | face found |",
             "|---|---|---|---|---|",

@@ -14,7 +14,7 @@ from repo_paths import VIDEOS
 from roadgaze.cli import main
 
 needs_videos = pytest.mark.skipif(
-    not VIDEOS.is_dir(), reason="../shared/data/videos not present (evaluation data)"
+    not VIDEOS.is_dir(), reason="the evaluation videos ($ROADGAZE_DATA/videos) not present"
 )
 GIFS = {
     "head-pose-face-detection-female.gif": 23,

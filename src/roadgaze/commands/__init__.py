@@ -5,6 +5,7 @@ from types import ModuleType
 from roadgaze.commands import (
     batch,
     bench,
+    data,
     demo,
     doctor,
     estimate,
@@ -31,6 +32,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     recover,
     bench,
     evaluate,
+    data,
     estimate,
     synth,
     model,

@@ -19,6 +19,7 @@ from roadgaze.commands import (
     run,
     schema,
     security,
+    speed,
     synth,
 )
 
@@ -26,6 +27,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     demo,
     run,
     listen,
+    speed,
     router,
     replay,
     batch,

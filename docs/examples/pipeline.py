@@ -68,9 +68,9 @@ def run(video: Path) -> AlertPrinter:
         finally:
             detector.close()
     print(
-        f"{summary.frames} frames, a face in {summary.frames_with_face}, in {summary.wall_s:.1f} s; "
-        f"lowest smoothed pitch {printer.min_pitch_deg:.1f} deg; alerts: "
-        f"{', '.join(printer.alerts) or 'none'}"
+        f"{summary.frames} frames, a face in {summary.frames_with_face}, "
+        f"in {summary.wall_s:.1f} s; lowest smoothed pitch {printer.min_pitch_deg:.1f} deg; "
+        f"alerts: {', '.join(printer.alerts) or 'none'}"
     )
     return printer
 

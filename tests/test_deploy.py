@@ -94,3 +94,35 @@ def test_the_unit_asks_for_what_the_daemon_implements() -> None:
     for hardening in ("ProtectSystem", "PrivateTmp", "NoNewPrivileges", "DevicePolicy"):
         assert hardening in settings
     assert settings["DeviceAllow"] == ["/dev/video0 rw"]
+
+
+def install_steps(unit_text: str) -> list[str]:
+    """The command lines of the unit header's install steps, in order."""
+    header = unit_text.split("# Install, as root, in this order:")[1].split("\n#\n")[0]
+    return [line[4:] for line in header.splitlines() if line.startswith("#   ")]
+
+
+def test_the_install_steps_create_what_the_unit_and_the_fetch_need() -> None:
+    text = UNIT.read_text(encoding="utf-8")
+    settings = unit_settings(text)
+    steps = install_steps(text)
+    index = {
+        name: next(i for i, step in enumerate(steps) if needle in step)
+        for name, needle in (
+            ("clone", "git clone"),
+            ("user", "useradd"),
+            ("cache", "install -d -o roadgaze -g roadgaze -m 0750 /var/cache/roadgaze"),
+            ("fetch", "roadgaze model fetch"),
+            ("enable", "systemctl enable"),
+        )
+    }
+    # The fetch runs as `roadgaze` before the service ever started, so before CacheDirectory=
+    # made /var/cache/roadgaze: the folder is made for it, with the unit's owner and mode.
+    assert index["user"] < index["cache"] < index["fetch"] < index["enable"]
+    assert settings["CacheDirectory"] == ["roadgaze"] and settings["CacheDirectoryMode"] == ["0750"]
+    assert "ROADGAZE_CACHE_DIR=/var/cache/roadgaze" in steps[index["fetch"]]
+    # Documentation= names a file the steps put there: the clone's docs/deployment.md.
+    (documentation,) = settings["Documentation"]
+    clone_dir = steps[index["clone"]].split("#")[0].split()[-1]
+    assert documentation.startswith(f"file://{clone_dir}/")
+    assert (REPO / documentation.removeprefix(f"file://{clone_dir}/")).is_file()

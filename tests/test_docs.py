@@ -4,6 +4,7 @@ table of docs/paper.md is what the code computes."""
 from __future__ import annotations
 
 import re
+import sys
 
 import numpy as np
 import pytest
@@ -75,3 +76,24 @@ def test_docs_link_to_files_that_exist(name: str) -> None:
     text = (REPO / "docs" / name).read_text()
     for target in re.findall(r"\]\(([^)#:]+)(?:#[^)]*)?\)", text):
         assert (REPO / "docs" / target).exists(), f"docs/{name} links to missing {target}"
+
+
+INSTALLED_IMPORTS = {
+    "roadgaze", "numpy", "cv2", "mediapipe", "zenoh", "pydantic", "matplotlib", "tqdm", "skimage",
+    "filterpy", "cryptography", "pyarrow", "ray", "foxglove", "mcap",
+}  # fmt: skip
+"""What `pip install roadgaze` and its extras (fleet, ray, foxglove) bring, by import name."""
+
+
+def test_python_examples_in_the_docs_import_only_what_the_install_has_or_say_how() -> None:
+    """A snippet importing anything else (pandas, once) must say `pip install NAME` just before."""
+    missing = []
+    for path in [*(REPO / "docs").glob("*.md"), REPO / "README.md"]:
+        text = path.read_text(encoding="utf-8")
+        for block in re.finditer(r"```python\n(.*?)```", text, re.DOTALL):
+            before = text[max(0, block.start() - 400) : block.start()]
+            for name in re.findall(r"^\s*(?:import|from)\s+(\w+)", block.group(1), re.MULTILINE):
+                known = name in INSTALLED_IMPORTS or name in sys.stdlib_module_names
+                if not known and f"pip install {name}" not in before:
+                    missing.append(f"{path.name}: {name}")
+    assert missing == []

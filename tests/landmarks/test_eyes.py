@@ -263,7 +263,7 @@ def test_mirror_average_keeps_the_eyes_symmetric() -> None:
         )
 
 
-@pytest.mark.skipif(not POINTING04.is_dir(), reason="needs ../shared/data/pointing04-dev")
+@pytest.mark.skipif(not POINTING04.is_dir(), reason="needs the Pointing'04 set ($ROADGAZE_DATA)")
 def test_iris_468_is_the_persons_right_eye_on_a_frontal_still() -> None:
     from roadgaze.config import Config
     from roadgaze.evaluation.images import read_image

@@ -5,6 +5,7 @@ from types import ModuleType
 from roadgaze.commands import (
     batch,
     bench,
+    data,
     demo,
     doctor,
     estimate,
@@ -18,6 +19,7 @@ from roadgaze.commands import (
     run,
     schema,
     security,
+    speed,
     synth,
 )
 
@@ -25,12 +27,14 @@ COMMANDS: tuple[ModuleType, ...] = (
     demo,
     run,
     listen,
+    speed,
     router,
     replay,
     batch,
     recover,
     bench,
     evaluate,
+    data,
     estimate,
     synth,
     model,

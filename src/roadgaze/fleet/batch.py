@@ -56,22 +56,43 @@ class BatchOptions:
 
 @contextmanager
 def batch_lock(out_dir: Path) -> Iterator[None]:
-    """Hold the output folder for this batch; ConfigError when another batch holds it."""
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-        descriptor = os.open(out_dir / LOCK_NAME, os.O_RDWR | os.O_CREAT, 0o644)
-    except OSError as exc:
-        raise ConfigError(f"cannot write to output folder {out_dir}: {exc.strerror}") from None
-    try:
+    """Hold the output folder for this batch; ConfigError when another batch holds it.
+
+    The lock file is removed on the way out, while still held. A batch that opened the file
+    just before it went checks, once it holds its lock, that the path still names the file it
+    locked, and takes a fresh one otherwise, so two batches never both hold the folder.
+    """
+    path = out_dir / LOCK_NAME
+    while True:
+        try:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            descriptor = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise ConfigError(f"cannot write to output folder {out_dir}: {exc.strerror}") from None
         try:
             fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
+            os.close(descriptor)
             raise ConfigError(
                 f"another roadgaze batch is writing to {out_dir}; wait for it or pick another --out"
             ) from None
+        if _same_file(descriptor, path):
+            break
+        os.close(descriptor)
+    try:
         yield
     finally:
+        path.unlink(missing_ok=True)
         os.close(descriptor)
+
+
+def _same_file(descriptor: int, path: Path) -> bool:
+    try:
+        named = path.stat()
+    except FileNotFoundError:
+        return False
+    held = os.fstat(descriptor)
+    return (held.st_dev, held.st_ino) == (named.st_dev, named.st_ino)
 
 
 def pinned_model(config: Config) -> Config:

@@ -23,6 +23,7 @@ from typing import Protocol, Self
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.eye_records import EyeCalibrationStatus as EyeCalibrationStatus
 from roadgaze.eye_records import EyeMeasurement as EyeMeasurement
 from roadgaze.eye_records import EyesFeatures as EyesFeatures
 from roadgaze.eye_records import EyeStatus as EyeStatus

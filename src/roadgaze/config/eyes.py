@@ -63,6 +63,17 @@ class EyeMonitorSettings(Section):
     lower edge, so an eyes-only glance beyond 30 deg sideways or 20 deg down leaves it despite
     the deadband (with the default road)."""
     eye_neutral_limit_deg: float = Field(default=15.0, ge=0)
+    """The learned resting eye yaw is used within +-this (Pointing'04: per-subject resting yaw
+    -8..+17 deg, docs/eyes.md)."""
+    eye_neutral_pitch_limit_deg: float = Field(default=30.0, ge=0)
+    """The learned resting eye pitch is used within +-this (real faces read -26..+15 deg looking
+    ahead, docs/eyes.md)."""
+    eye_calibration_s: float = Field(default=3.0, gt=0)
+    """Open-eyed, on-road, steady-head time the driver's resting eye direction and its noise are
+    learned from before the eyes may move the gaze (until then the gaze is the head pose)."""
+    eye_noise_sigmas: float = Field(default=3.0, gt=0)
+    """The eyes move the gaze only beyond this many of the driver's measured standard deviations
+    of each axis (and never within `gaze_deadband_deg`)."""
     microsleep_s: float = Field(default=1.0, gt=0)
     sleep_s: float = Field(default=3.0, gt=0)
     unresponsive_closed_s: float = Field(default=6.0, gt=0)

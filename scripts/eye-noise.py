@@ -14,7 +14,8 @@ The figures behind the eye calibration's thresholds (docs/eyes.md, "Eye directio
 - **The shared GIFs** (`DATA/videos`, VIDEO mode, the whole pipeline with the default settings):
   the eye direction on the open-eyed frames with a steady head (|yaw rate| <= 60 deg/s) and the
   head within 20 deg of ahead: mean (the clip's resting direction), standard deviation around it,
-  and frame-to-frame noise (standard deviation of the differences / sqrt 2); then what the
+  and frame-to-frame noise (standard deviation of the differences / sqrt 2), and the mean pitch
+  over every open frame with a direction (a sweeping head included); then what the
   monitor learned (calibration state, noise, thresholds) and on how many frames the calibrated
   eyes moved the gaze off the head pose.
 """
@@ -109,9 +110,11 @@ def video(path: Path, config: Config) -> dict[str, Any]:
                 records.append(pipeline.process(frame).record)
     finally:
         detector.close()
-    yaws, pitches = [], []
+    yaws, pitches, any_pitches = [], [], []
     for record in records:
         sample, eyes = record.sample, record.verdict.eyes
+        if eyes.status.value == "open" and eyes.eye_pitch_deg is not None:
+            any_pitches.append(eyes.eye_pitch_deg)
         steady = sample.yaw_rate_dps is not None and abs(sample.yaw_rate_dps) <= STEADY_DPS
         ahead = sample.yaw_deg is not None and abs(sample.yaw_deg) <= AHEAD_DEG
         judged = eyes.status.value == "open" and not eyes.reason and steady and ahead
@@ -133,6 +136,8 @@ def video(path: Path, config: Config) -> dict[str, Any]:
         "learned_noise_deg": calibration.noise_deg(),
         "thresholds_deg": thresholds_deg(config.monitor, calibration),
         "frames_eyes_moved_gaze": moved,
+        "open_with_direction": len(any_pitches),
+        "pitch_mean_any_deg": statistics.fmean(any_pitches) if any_pitches else math.nan,
         "zones": {z: sum(1 for r in records if r.verdict.zone == z) for z in _zones(records)},
     }
     for name, values in (("yaw", yaws), ("pitch", pitches)):
@@ -170,7 +175,11 @@ def main() -> int:
         if not path.is_file():
             continue
         v = report[name] = video(path, config)
-        print(f"{name}: {v['frames']} frames, {v['steady_ahead_open']} open, steady, ahead")
+        print(
+            f"{name}: {v['frames']} frames, {v['steady_ahead_open']} open, steady, ahead; "
+            f"pitch {v['pitch_mean_any_deg']:+.1f} deg over the {v['open_with_direction']} open "
+            "frames with a direction"
+        )
         for axis in ("yaw", "pitch"):
             print(
                 f"  {axis:5}: mean {v[f'{axis}_mean_deg']:+.1f}, sd {v[f'{axis}_sd_deg']:.1f}, "

@@ -147,3 +147,20 @@ def test_a_sweeping_head_teaches_neither_the_eyes_nor_the_neutral() -> None:
     steady = learn_neutral(CONFIG, state, -12.0, 10.0, 0.1, yaw_rate_dps=20.0)
     assert fast == (0.0, 0.0, 0.0, 0.0)
     assert steady[:2] == pytest.approx((-12.0, 10.0))
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("eye_calibration_s", 0.0),
+        ("eye_noise_sigmas", -1.0),
+        ("eye_neutral_pitch_limit_deg", -5.0),
+        ("neutral_max_rate_dps", 0.0),
+    ],
+)
+def test_bad_calibration_settings_are_refused_naming_the_key(key: str, value: float) -> None:
+    from pydantic import ValidationError
+
+    with pytest.raises(ValidationError, match=key):
+        MonitorConfig.model_validate({key: value})
+    assert MonitorConfig.model_validate({"neutral_max_rate_dps": None}).neutral_max_rate_dps is None

@@ -29,7 +29,7 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
     assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
     assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/3"
-    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/3"
+    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/4"
     snapshot = schemas["state"]["$defs"]["MonitorSnapshot"]
     assert {"zone", "neutral_pitch_deg", "pitch_deg"} <= set(snapshot["required"])
     # yaw/3 and state/3 add the eyes; alert/2 the closure and drowsiness kinds
@@ -37,6 +37,8 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     eye_fields |= {"closure_s", "perclos", "blinks", "eyes_unavailable_s", "degraded"}
     assert eye_fields <= set(schemas["yaw"]["required"])
     assert eye_fields <= set(snapshot["required"])
+    # state/4 adds the eye calibration to the monitor
+    assert "eye_calibration" in snapshot["required"]
     kinds = set(schemas["alert"]["$defs"]["AlertKind"]["enum"])
     assert {"microsleep", "sleep", "drowsy", "unresponsive", "degraded"} <= kinds
     assert {"closure_s", "perclos", "reason"} <= set(schemas["alert"]["required"])

@@ -193,6 +193,9 @@ def test_eye_report_counts_every_face_and_compares_gaze_with_head() -> None:
     text = format_eye_report(report)
     assert "open 3 (60.00%) (of which 1 looking down), closed 1 (20.00%), not judged 1" in text
     assert report.to_json_dict()["open_rate"] == pytest.approx(0.6)
+    # The open-eyed set leaves out tilt -60 (f1, open by the look-down rule).
+    assert report.open_eyed() == (4, 2, 1, 1)
+    assert "open-eyed (|tilt| <= 30): 4 faces, open 2 (50.00%), closed 1 (25.00%)" in text
 
 
 def test_pitch_report_rank_correlation_bias_and_lap() -> None:

@@ -215,6 +215,9 @@ class MonitorConfig(EyeMonitorSettings):
     neutral_time_constant_s: float = Field(default=60.0, gt=0)
     neutral_limit_deg: float = Field(default=20.0, ge=0)
     neutral_pitch_limit_deg: float = Field(default=20.0, ge=0)
+    neutral_max_rate_dps: float | None = Field(default=60.0, gt=0)
+    """A head turning faster than this (smoothed yaw rate) is passing through, not looking at
+    the road: it teaches neither the neutral pose nor the eye calibration; None: no limit."""
     long_distraction_s: float = Field(default=3.0, gt=0)
     critical_distraction_s: float = Field(default=6.0, gt=0)
     vats_window_s: float = Field(default=30.0, gt=0)

@@ -23,7 +23,7 @@ import numpy.typing as npt
 from roadgaze.config import Config, LandmarksConfig
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored
 from roadgaze.landmarks.engines import FaceCounting, FaceRunner, open_engine
-from roadgaze.landmarks.eye_contrast import eye_contrast
+from roadgaze.landmarks.eye_contrast import eye_contrast, eye_sharpness
 from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
 from roadgaze.landmarks.features import (
     DEFAULT_CHOICE,
@@ -332,15 +332,26 @@ class Landmarker(ClosesOnExit):
     def _features(
         self, found: tuple[FoundFace, ...], gray: npt.NDArray[np.uint8]
     ) -> list[FaceFeatures]:
-        """Each face measured, with its blendshapes and the contrast of its eye openings (on
-        `gray`, the image it was found in)."""
+        """Each face measured, with its blendshapes and the contrast and sharpness of its eyes
+        (on `gray`, the image it was found in)."""
         size = (gray.shape[1], gray.shape[0])
         faces: list[FaceFeatures] = []
         for face in found:
             pixels = face.landmarks_px
             features = features_from_landmarks(pixels, size, face.matrix, self._choice)
             contrast = (eye_contrast(gray, pixels, RIGHT_EYE), eye_contrast(gray, pixels, LEFT_EYE))
-            faces.append(replace(features, blendshapes=face.blendshapes, eye_contrast=contrast))
+            sharpness = (
+                eye_sharpness(gray, pixels, RIGHT_EYE),
+                eye_sharpness(gray, pixels, LEFT_EYE),
+            )
+            faces.append(
+                replace(
+                    features,
+                    blendshapes=face.blendshapes,
+                    eye_contrast=contrast,
+                    eye_sharpness=sharpness,
+                )
+            )
         return faces
 
     def close(self) -> None:

@@ -71,6 +71,7 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("long_blinks", FieldType.INT),
     ("eyes_unavailable_s", FieldType.FLOAT),
     ("degraded", FieldType.BOOL),
+    ("eye_calibration", FieldType.STR),
     ("alerts", FieldType.STR_LIST),
     ("yaw_offline_deg", FieldType.FLOAT),
     ("pitch_offline_deg", FieldType.FLOAT),
@@ -181,6 +182,7 @@ def eye_fields(eyes: EyesVerdict) -> dict[str, Any]:
         "long_blinks": eyes.long_blinks,
         "eyes_unavailable_s": round(eyes.unavailable_s, 3),
         "degraded": eyes.degraded,
+        "eye_calibration": eyes.calibration.value,
     }
 
 

@@ -161,6 +161,7 @@ class Health:
                 speed_kmh=speed_kmh,
                 speed_source=speed_source,
                 alert_counts=dict(verdict.alert_counts),
+                eye_calibration=eyes.calibration,
             ),
             config={
                 "monitor": monitor.model_dump(mode="json"),

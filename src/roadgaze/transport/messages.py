@@ -16,6 +16,7 @@ from roadgaze.types import (
     Alert,
     AlertKind,
     AlertLevel,
+    EyeCalibrationStatus,
     EyeStatus,
     EyesVerdict,
     FrameRecord,
@@ -24,7 +25,7 @@ from roadgaze.types import (
 
 YAW_SCHEMA = "roadgaze.yaw/3"
 ALERT_SCHEMA = "roadgaze.alert/2"
-STATE_SCHEMA = "roadgaze.state/3"
+STATE_SCHEMA = "roadgaze.state/4"
 
 
 class _Message(BaseModel):
@@ -269,6 +270,11 @@ class MonitorSnapshot(EyeFields):
     speed_kmh: float | None
     speed_source: Literal["none", "waiting", "fresh", "stale", "invalid"]
     alert_counts: dict[str, int]
+    eye_calibration: EyeCalibrationStatus = Field(
+        default=EyeCalibrationStatus.NONE,
+        description="none, learning or calibrated: the eyes move the gaze only once the "
+        "driver's resting eye direction is learned (calibrated).",
+    )
 
 
 class StateMessage(_Message):
@@ -278,10 +284,11 @@ class StateMessage(_Message):
     `roadgaze.state/3` adds link and delivery fields to `transport` (see `TransportStatus`, and
     `vss_sent`), the speed source `invalid`, the eye fields of the yaw message to `monitor`, and
     the status `degraded` (with a problem saying why) while the eyes have been unavailable too
-    long. Every earlier field keeps its name and meaning.
+    long; `roadgaze.state/4` adds `eye_calibration` to `monitor`. Every earlier field keeps its
+    name and meaning.
     """
 
-    schema_id: Literal["roadgaze.state/3"] = Field(default="roadgaze.state/3", alias="schema")
+    schema_id: Literal["roadgaze.state/4"] = Field(default="roadgaze.state/4", alias="schema")
     vehicle_id: str
     wall_time: float
     status: Literal["starting", "running", "degraded", "stopping", "stopped"]

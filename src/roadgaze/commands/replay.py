@@ -221,6 +221,10 @@ def run(args: argparse.Namespace, config: Config) -> int:
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
     fill_offline(args, config)
     report(args, summary, stats)
+    if bus.undelivered():
+        from roadgaze.daemon import EXIT_UNDELIVERED
+
+        return EXIT_UNDELIVERED  # the warning naming them was logged when the link closed
     return 0
 
 

@@ -44,7 +44,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
 
     stop = StopFlag()
     # Before zenoh is imported: a stop asked for during start-up is kept.
-    with signal_handlers(stop, doing="stopping the router"):
+    with signal_handlers(stop, doing="stopping the router", log_name="roadgaze.router"):
         from roadgaze.transport.router import Router, RouterSettings
 
         settings = RouterSettings(listen=tuple(args.listen or ()), config_file=args.zenoh_config)

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, Self
 
 from roadgaze.errors import TransportError
-from roadgaze.transport.session import zenoh_error_text
+from roadgaze.transport.session import load_zenoh_file, zenoh_error_text
 from roadgaze.types import ClosesOnExit
 
 log = logging.getLogger("roadgaze.router")
@@ -67,10 +67,8 @@ def router_config(settings: RouterSettings) -> RouterConfig:
             default_listen = _endpoints(json.loads(zconf.get_json("listen/endpoints")))
         else:
             path = settings.config_file
-            if not path.is_file():
-                raise TransportError(f"zenoh config file {path} not found")
             default_listen = _endpoints(json.loads(zenoh.Config().get_json("listen/endpoints")))
-            zconf = zenoh.Config.from_file(str(path))
+            zconf = load_zenoh_file(path)
             mode = json.loads(zconf.get_json("mode"))
             if mode not in (None, "router"):
                 raise TransportError(

@@ -69,12 +69,12 @@ def test_no_usable_rate_and_a_bad_timestamp_is_refused_in_one_line(
     with pytest.raises(SourceError, match=r"stall at frame 4.*no usable frame rate") as caught:
         base.t_s(4, 0.3)
     assert "\n" not in str(caught.value) and "re-encode" in str(caught.value)
-    with pytest.raises(SourceError, match=r"jump 118\.000 s at frame 5"):
+    with pytest.raises(SourceError, match=r"step 118\.000 s at frame 5"):
         _jump_without_rate(fps)
 
 
 def _jump_without_rate(fps: float | None) -> float:
-    """Steps of 0.1 s, then one of 118 s: judged against the steps seen (no rate)."""
+    """Steps of 0.1 s, then one of 118 s: over 1 s (no rate to judge it by)."""
     base = TimeBase("x", fps)
     for index, t_s in enumerate([0.0, 0.1, 0.2, 0.3, 0.4]):
         base.t_s(index, t_s)
@@ -197,3 +197,29 @@ def test_a_one_pixel_video_blames_the_video(tmp_path: Path) -> None:
     writer.release()
     with pytest.raises(SourceError, match=r"dot.avi is 1x1 pixels: too small to hold a face"):
         VideoFileSource(path)
+
+
+def test_the_issues_mp4_with_sample_durations_of_zero_is_refused_at_its_second_frame(
+    tmp_path: Path,
+) -> None:
+    """2 s at 30 fps whose `stts` sample durations are patched to 0: FFmpeg reads 0.5 fps and
+    a frame every 2 s (118 s in all), which raised critical alerts before."""
+    import struct
+
+    good = tmp_path / "good.mp4"
+    writer = cv2.VideoWriter(str(good), cv2.VideoWriter_fourcc(*"mp4v"), 30.0, (64, 48))
+    for index in range(60):
+        writer.write(np.full((48, 64, 3), index * 4, np.uint8))
+    writer.release()
+    data = bytearray(good.read_bytes())
+    stts = data.find(b"stts")
+    for entry in range(struct.unpack(">I", data[stts + 8 : stts + 12])[0]):
+        struct.pack_into(">I", data, stts + 16 + 8 * entry, 0)  # sample_delta = 0
+    corrupt = tmp_path / "zero_durations.mp4"
+    corrupt.write_bytes(bytes(data))
+    with VideoFileSource(good) as source:
+        assert [frame.t_s for frame in source][-1] == pytest.approx(59 / 30)
+    with VideoFileSource(corrupt) as source, pytest.raises(SourceError) as caught:
+        list(source)
+    assert "timestamps step 2.000 s at frame 1" in str(caught.value)
+    assert "no usable frame rate (0.5 fps)" in str(caught.value)

@@ -2,8 +2,9 @@
 
 The monitor's timers (a 3 s glance, a 30 s window) run on frame times, so a corrupt container
 clock raises or hides alerts. `TimeBase` checks each frame's container timestamp against the
-previous one: going backwards, standing still (a stall) or jumping far beyond one frame period
-(more than `JUMP_PERIODS` periods and more than `JUMP_MIN_S`) flags it. On the first flag it
+previous one: going backwards, standing still (a stall), a step shorter than one period at
+`MAX_FPS`, or a jump far beyond one frame period (more than `JUMP_PERIODS` periods and more than
+`JUMP_MIN_S`; without a usable rate, any step over `JUMP_MIN_S`) flags it. On the first flag it
 falls back to frame-index time (`index / fps`, continuing from the last good time) when the
 container's frame rate is sane (`MIN_FPS`..`MAX_FPS`), and says so once; with no sane rate
 either it raises `SourceError` (neither clock can time the monitor). A missing timestamp counts
@@ -14,8 +15,6 @@ from __future__ import annotations
 
 import logging
 import math
-import statistics
-from collections import deque
 
 from roadgaze.errors import SourceError
 
@@ -28,8 +27,6 @@ JUMP_PERIODS = 10.0
 JUMP_MIN_S = 1.0
 """A step between two frames is a jump when it exceeds both JUMP_PERIODS frame periods and
 JUMP_MIN_S seconds (a variable-rate recording's hiccup stays below)."""
-RECENT_STEPS = 15
-"""Without a usable rate, jumps are judged against the median of this many recent steps."""
 
 
 def sane_fps(fps: float | None) -> float | None:
@@ -54,7 +51,6 @@ class TimeBase:
         self._index_origin = 0
         self._time_origin_s = 0.0
         self._previous_t_s: float | None = None
-        self._steps: deque[float] = deque(maxlen=RECENT_STEPS)
         if self.fps is None:
             log.warning(
                 "%s: its container gives no usable frame rate (%s): frames are timed by their "
@@ -85,8 +81,6 @@ class TimeBase:
         return t_s
 
     def _accept(self, t_s: float) -> None:
-        if self._previous_t_s is not None:
-            self._steps.append(t_s - self._previous_t_s)
         self._previous_t_s = t_s
 
     def _problem(self, index: int, t_s: float | None) -> str | None:
@@ -100,18 +94,17 @@ class TimeBase:
             return f"timestamps go backwards at frame {index} ({previous:.3f} s -> {t_s:.3f} s)"
         if step_s == 0:
             return f"timestamps stall at frame {index} (t = {t_s:.3f} s twice)"
-        if self.fps is not None:
-            period_s = 1.0 / self.fps
-            reference = f"{self.fps:g} fps"
-        elif len(self._steps) >= 3:
-            period_s = statistics.median(self._steps)
-            reference = f"the {period_s * 1000:.1f} ms steps before it"
-        else:
+        if step_s < 1.0 / MAX_FPS:
+            return f"timestamps step only {step_s * 1000:.3f} ms at frame {index}"
+        if self.fps is None and step_s > JUMP_MIN_S:  # under 1 fps: no use to the monitor
+            return f"timestamps step {step_s:.3f} s at frame {index}"
+        if self.fps is None:
             return None
+        period_s = 1.0 / self.fps
         if step_s > JUMP_PERIODS * period_s and step_s > JUMP_MIN_S:
             return (
                 f"timestamps jump {step_s:.3f} s at frame {index}, {step_s / period_s:.0f} "
-                f"periods of {reference}"
+                f"periods of {self.fps:g} fps"
             )
         return None
 

@@ -223,3 +223,25 @@ def test_the_issues_mp4_with_sample_durations_of_zero_is_refused_at_its_second_f
         list(source)
     assert "timestamps step 2.000 s at frame 1" in str(caught.value)
     assert "no usable frame rate (0.5 fps)" in str(caught.value)
+
+
+def test_an_avi_whose_header_gives_a_rate_of_zero_is_refused_not_read_at_25_fps(
+    tmp_path: Path,
+) -> None:
+    """The issue: such a file was read at FFmpeg's assumed 25 fps (timers 18 % off), silently."""
+    import struct
+
+    path = tmp_path / "rate0.avi"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 30.0, (64, 48))
+    for index in range(10):
+        writer.write(np.full((48, 64, 3), index * 20, np.uint8))
+    writer.release()
+    data = bytearray(path.read_bytes())
+    with VideoFileSource(path) as source:
+        assert source.info.fps == 30.0
+    header = data.find(b"strh")
+    struct.pack_into("<I", data, header + 32, 0)  # the video stream's dwRate
+    path.write_bytes(bytes(data))
+    assert cv2.VideoCapture(str(path), cv2.CAP_FFMPEG).get(cv2.CAP_PROP_FPS) == 25.0
+    with pytest.raises(SourceError, match=r"rate0\.avi: its AVI header gives no frame rate"):
+        VideoFileSource(path)

@@ -26,7 +26,7 @@ from roadgaze.capture.base import (
     as_bgr,
     finite_positive,
 )
-from roadgaze.capture.timebase import TimeBase, sane_fps
+from roadgaze.capture.timebase import TimeBase, check_avi_rate, sane_fps
 from roadgaze.errors import SourceError
 from roadgaze.types import Frame
 
@@ -63,6 +63,8 @@ class VideoFileSource(SourceBase):
         self.path = Path(path)
         if not self.path.is_file():
             raise SourceError(f"video file {self.path} not found; pass an existing video file")
+        if capture_factory is None:
+            check_avi_rate(self.path)
         factory = capture_factory or (lambda name: cv2.VideoCapture(name, cv2.CAP_FFMPEG))
         self._capture: VideoCaptureLike | None = factory(str(self.path))
         if not self._capture.isOpened():

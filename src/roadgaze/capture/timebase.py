@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import logging
 import math
+import struct
+from pathlib import Path
 
 from roadgaze.errors import SourceError
 
@@ -27,6 +29,9 @@ JUMP_PERIODS = 10.0
 JUMP_MIN_S = 1.0
 """A step between two frames is a jump when it exceeds both JUMP_PERIODS frame periods and
 JUMP_MIN_S seconds (a variable-rate recording's hiccup stays below)."""
+
+AVI_HEADER_BYTES = 16 * 1024
+"""How much of an AVI file is read for its stream headers."""
 
 
 def sane_fps(fps: float | None) -> float | None:
@@ -126,4 +131,30 @@ class TimeBase:
             self.name,
             problem,
             self.fps,
+        )
+
+
+def check_avi_rate(path: Path) -> None:
+    """Raise SourceError when `path` is an AVI whose video stream header gives no frame rate
+    (`dwRate` or `dwScale` 0): FFmpeg then silently assumes 25 fps and invents every frame's
+    time from it (AVI has no per-frame times), so no clock could time the monitor. Anything that
+    is not such an AVI passes."""
+    try:
+        with path.open("rb") as stream:
+            head = stream.read(AVI_HEADER_BYTES)
+    except OSError:
+        return  # the capture reports an unreadable file itself
+    if head[:4] != b"RIFF" or head[8:12] != b"AVI ":
+        return
+    at = head.find(b"strh")
+    while at >= 0 and head[at + 8 : at + 12] != b"vids":  # the video stream's header
+        at = head.find(b"strh", at + 4)
+    if at < 0 or len(head) < at + 36:
+        return
+    scale, rate = struct.unpack_from("<II", head, at + 28)
+    if scale == 0 or rate == 0:
+        raise SourceError(
+            f"video {path}: its AVI header gives no frame rate (dwScale {scale}, dwRate {rate}); "
+            "FFmpeg would assume 25 fps and invent every frame's time: neither can time the "
+            "monitor; re-encode it with its real rate, e.g. ffmpeg -r 30 -i IN OUT.mp4"
         )

@@ -193,3 +193,19 @@ class Router(ClosesOnExit):
                 "zenoh router stopped (%d sessions served)",
                 self.sessions_opened,
             )
+
+
+ZENOH_LOG = "error,zenoh_link_tls=warn"
+"""Zenoh's own log in `roadgaze router`: errors, and the TLS link's warnings, which name each
+refused handshake (a plain TCP client, no or a foreign certificate). `RUST_LOG` replaces it."""
+
+
+def log_refused_handshakes() -> None:
+    """Turn on Zenoh's own log (stderr, Zenoh's format) for refused TLS handshakes: Zenoh opens
+    no transport for them, so the transport events never see them. Once per process."""
+    import zenoh
+
+    try:
+        zenoh.init_log_from_env_or(ZENOH_LOG)
+    except Exception as exc:  # already initialised in this process
+        log.debug("zenoh log not initialised: %s", exc)

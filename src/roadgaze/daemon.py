@@ -11,6 +11,7 @@ publisher's cache; a failed put): a warning names them.
 
 from __future__ import annotations
 
+import gc
 import logging
 from collections.abc import Iterator
 from contextlib import ExitStack, closing, contextmanager
@@ -173,4 +174,7 @@ def run_daemon(
             health.frames,
             health.alerts_raised,
         )
+    # MediaPipe's objects are finalised here, while the stop handlers still stand (a second
+    # signal during a finaliser then exits 1 at once, never "Exception ignored" and exit 130).
+    gc.collect()
     return EXIT_UNDELIVERED if bus.undelivered() else 0

@@ -89,7 +89,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--publish",
         action="store_true",
-        help="publish yaw, alerts, liveliness and state on Zenoh, stamped with the video's time",
+        help="publish yaw, alerts, liveliness and state on Zenoh, stamped with the video's time "
+        "(exit 4 when some alerts never reached the bus, each named)",
     )
     add_zenoh_options(parser)
 

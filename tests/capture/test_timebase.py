@@ -242,6 +242,10 @@ def test_an_avi_whose_header_gives_a_rate_of_zero_is_refused_not_read_at_25_fps(
     header = data.find(b"strh")
     struct.pack_into("<I", data, header + 32, 0)  # the video stream's dwRate
     path.write_bytes(bytes(data))
+    with VideoFileSource(path) as source:  # FFmpeg takes the main header's period: fine
+        assert source.info.fps == pytest.approx(30.0, rel=1e-3)
+    struct.pack_into("<I", data, data.find(b"avih") + 8, 0)  # dwMicroSecPerFrame
+    path.write_bytes(bytes(data))
     assert cv2.VideoCapture(str(path), cv2.CAP_FFMPEG).get(cv2.CAP_PROP_FPS) == 25.0
     with pytest.raises(SourceError, match=r"rate0\.avi: its AVI header gives no frame rate"):
         VideoFileSource(path)

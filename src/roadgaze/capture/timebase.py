@@ -135,8 +135,9 @@ class TimeBase:
 
 
 def check_avi_rate(path: Path) -> None:
-    """Raise SourceError when `path` is an AVI whose video stream header gives no frame rate
-    (`dwRate` or `dwScale` 0): FFmpeg then silently assumes 25 fps and invents every frame's
+    """Raise SourceError when `path` is an AVI whose headers give no frame rate (the video
+    stream's `dwRate` or `dwScale` 0, and the main header's `dwMicroSecPerFrame` 0): FFmpeg then
+    silently assumes 25 fps and invents every frame's
     time from it (AVI has no per-frame times), so no clock could time the monitor. Anything that
     is not such an AVI passes."""
     try:
@@ -152,9 +153,12 @@ def check_avi_rate(path: Path) -> None:
     if at < 0 or len(head) < at + 36:
         return
     scale, rate = struct.unpack_from("<II", head, at + 28)
-    if scale == 0 or rate == 0:
+    main_header = head.find(b"avih")
+    frame_us = struct.unpack_from("<I", head, main_header + 8)[0] if main_header >= 0 else 0
+    if (scale == 0 or rate == 0) and frame_us == 0:  # FFmpeg falls back on avih's period
         raise SourceError(
-            f"video {path}: its AVI header gives no frame rate (dwScale {scale}, dwRate {rate}); "
+            f"video {path}: its AVI header gives no frame rate (dwScale {scale}, dwRate {rate}, "
+            f"dwMicroSecPerFrame {frame_us}); "
             "FFmpeg would assume 25 fps and invent every frame's time: neither can time the "
             "monitor; re-encode it with its real rate, e.g. ffmpeg -r 30 -i IN OUT.mp4"
         )

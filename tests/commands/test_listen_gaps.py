@@ -202,7 +202,18 @@ def test_something_listening_that_refuses_the_session_gets_a_tls_hint() -> None:
              "--timeout", "2"],
             capture_output=True, text=True, timeout=60, env=child_env(), check=False,
         )  # fmt: skip
+        waiting = subprocess.Popen(  # no --timeout: it waits, and says why at once
+            [sys.executable, "-m", "roadgaze", "listen", "--zenoh-connect", plain.connect[0]],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=child_env(),
+        )  # fmt: skip
+        try:
+            said = LineReader(waiting, waiting.stderr).until("zenoh session refused", 30.0)
+            waiting.send_signal(signal.SIGTERM)
+            assert waiting.wait(timeout=20) == 0
+        finally:
+            zh.stop_process(waiting)
     assert result.returncode == 1 and "Traceback" not in result.stderr
     assert "something listens at tcp/127.0.0.1" in result.stderr
+    assert "takes tls/ endpoints" in said[-1]
     nobody = SessionPlan("client", (endpoint(free_port()),), (), {})
     assert unreachable_hint(nobody) == "is `roadgaze run` or a router up?"

@@ -232,6 +232,9 @@ def open_session(
             ) from None
         if not announced:
             log.info("waiting for a router or daemon (%s)", plan.describe())
+            hint = unreachable_hint(plan)
+            if hint.startswith("something listens"):  # it will not get better by waiting
+                log.warning("zenoh session refused (%s): %s", reason, hint)
             announced = True
         time.sleep(retry_s)
 

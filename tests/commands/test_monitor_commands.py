@@ -69,12 +69,12 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
         (
             "yaw",
             {"seq": 9, "t_s": 0.3, "yaw_deg": -12.34, "gaze": "on_road"},
-            "yaw    car-1 #9 t=0.30s   -12.3° on_road",
+            "yaw    car-1 #9      t=0.30s      -12.3° on_road",
         ),
         (
             "yaw",
             {"seq": 9, "t_s": 0.3, "yaw_deg": 1.0, "pitch_deg": -41.26, "zone": "lap"},
-            "yaw    car-1 #9 t=0.30s    +1.0° pitch   -41.3° lap",
+            "yaw    car-1 #9      t=0.30s       +1.0° pitch   -41.3° lap",
         ),
         (
             "yaw",
@@ -86,7 +86,7 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
                 "zone": None,
                 "gaze": "unknown",
             },
-            "yaw    car-1 #9 t=0.30s     --   pitch     --   unknown",
+            "yaw    car-1 #9      t=0.30s        --   pitch     --   unknown",
         ),
         (
             "yaw",
@@ -105,15 +105,15 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
                 "perclos": 0.04,
                 "degraded": False,
             },
-            "yaw    car-1 #9 t=0.30s    -1.2° pitch   -11.1° centre_stack eyes open 0.17 "
+            "yaw    car-1 #9      t=0.30s       -1.2° pitch   -11.1° centre_stack eyes open 0.17 "
             "gaze -20.8°/-22.8° perclos 0.04",
         ),
         (
             "yaw",
             {"seq": 9, "t_s": 0.3, "yaw_deg": -1.0, "pitch_deg": -11.0, "zone": "road"}
             | {"eyes": "closed", "eye_openness": 0.02, "closure_s": 1.8, "degraded": True},
-            "yaw    car-1 #9 t=0.30s    -1.0° pitch   -11.0° road eyes closed 0.02 closed 1.8s "
-            "DEGRADED",
+            "yaw    car-1 #9      t=0.30s       -1.0° pitch   -11.0° road eyes closed 0.02 "
+            "closed 1.8s DEGRADED",
         ),
         (
             "alert",

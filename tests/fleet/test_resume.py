@@ -114,3 +114,8 @@ def test_a_worker_that_dies_fails_its_drive_after_the_retries_and_the_batch_goes
     assert (results["ok1"].status, results["ok2"].status) == ("ok", "ok")
     assert results["crash"].status == "failed"
     assert "worker process died 2 times" in (results["crash"].error or "")
+    # Each death is said on stderr and in batch.log, and counted for the summary.
+    assert (engine.worker_deaths, engine.retried) == (2, 1)
+    batch_log = (tmp_path / "batch.log").read_text()
+    assert batch_log.count("a worker process died while running drive crash") == 2
+    assert "try 1 of 2" in batch_log and "giving up on it (--retries)" in batch_log

@@ -20,7 +20,7 @@ from typing import Literal
 from roadgaze.config import Config
 from roadgaze.errors import ConfigError
 from roadgaze.fleet.drives import Drive
-from roadgaze.fleet.engines import Engine, LocalEngine, RayEngine
+from roadgaze.fleet.engines import RAY_TIMEOUT_S, Engine, LocalEngine, RayEngine
 from roadgaze.fleet.report import render_report
 from roadgaze.fleet.results import DriveResult
 from roadgaze.fleet.summary import BatchOutcome, summary_table
@@ -49,6 +49,8 @@ class BatchOptions:
     workers: int | None = None
     """Local: processes (default: one per core). Ray: drives in flight (default: cluster CPUs)."""
     ray_address: str | None = None
+    ray_timeout_s: float = RAY_TIMEOUT_S
+    """How long to wait for the Ray cluster at `ray_address` before failing."""
     content_hash: bool = False
     retries: int = 2
     progress: bool = True
@@ -107,7 +109,11 @@ def pinned_model(config: Config) -> Config:
 def make_engine(options: BatchOptions) -> Engine:
     if options.engine == "ray":
         return RayEngine(
-            options.out_dir / LOG_NAME, options.ray_address, options.workers, options.retries
+            options.out_dir / LOG_NAME,
+            options.ray_address,
+            options.workers,
+            options.retries,
+            options.ray_timeout_s,
         )
     return LocalEngine(options.out_dir / LOG_NAME, options.workers, options.retries)
 
@@ -175,7 +181,7 @@ def run_batch(drives: Sequence[Drive], config: Config, options: BatchOptions) ->
             run_start = time.perf_counter()
             progress = BatchProgress(len(to_run), options.progress)
             try:
-                with signal_handlers(stop):
+                with signal_handlers(stop, log_name="roadgaze.batch", hard_exit=False):
                     for result in engine.run(to_run, stop):
                         results[result.drive_id] = result
                         progress.update(result)
@@ -191,6 +197,8 @@ def run_batch(drives: Sequence[Drive], config: Config, options: BatchOptions) ->
             wall_s=wall_s,
             startup_s=startup_s,
             interrupted=stop.is_set(),
+            worker_deaths=getattr(engine, "worker_deaths", 0),
+            retries=getattr(engine, "retried", 0),
         )
         write_summary(out_dir, outcome)
     return outcome

@@ -251,6 +251,23 @@ class TransportStatus(_Message):
     yaw_not_sent: int = 0
     speed_oversize: int = Field(default=0, description="Speed payloads dropped unread (size).")
     state_queries_answered: int = 0
+    alerts_waiting: int = Field(
+        default=0,
+        ge=0,
+        description="roadgaze.state/4: alerts published while no link was up (or held before "
+        "the session opened) and still waiting for one; gone if the daemon stops first.",
+    )
+    alerts_lost: int = Field(
+        default=0,
+        ge=0,
+        description="roadgaze.state/4: alerts that will never reach a subscriber: pushed out "
+        "of the cache, put failed, dropped before the session opened, or no link at exit.",
+    )
+    undelivered_alerts: list[str] = Field(
+        default_factory=list,
+        description="roadgaze.state/4: the newest waiting and lost alerts (at most 20 of "
+        "each), e.g. '#3 long_distraction critical t=5.00s: held, no link yet'.",
+    )
 
 
 class MonitorSnapshot(EyeFields):
@@ -284,8 +301,9 @@ class StateMessage(_Message):
     `roadgaze.state/3` adds link and delivery fields to `transport` (see `TransportStatus`, and
     `vss_sent`), the speed source `invalid`, the eye fields of the yaw message to `monitor`, and
     the status `degraded` (with a problem saying why) while the eyes have been unavailable too
-    long; `roadgaze.state/4` adds `eye_calibration` to `monitor`. Every earlier field keeps its
-    name and meaning.
+    long; `roadgaze.state/4` adds `eye_calibration` to `monitor`, and `alerts_waiting`,
+    `alerts_lost` and `undelivered_alerts` to `transport` (the alert ledger). Every earlier field
+    keeps its name and meaning.
     """
 
     schema_id: Literal["roadgaze.state/4"] = Field(default="roadgaze.state/4", alias="schema")

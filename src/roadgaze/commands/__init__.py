@@ -5,6 +5,7 @@ from types import ModuleType
 from roadgaze.commands import (
     batch,
     bench,
+    conformance,
     demo,
     doctor,
     estimate,
@@ -28,6 +29,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     router,
     replay,
     batch,
+    conformance,
     recover,
     bench,
     evaluate,

@@ -18,10 +18,14 @@ from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
+import numpy as np
+import numpy.typing as npt
+
 from roadgaze.capture import FrameSource
 from roadgaze.config import Config, EyesConfig
 from roadgaze.landmarks.eyes import driver_eyes
 from roadgaze.monitor import Monitor
+from roadgaze.monitor.failures import check_frame
 from roadgaze.pipeline.handoff import Handoff
 from roadgaze.pipeline.runtime import Collector, loop_runtime
 from roadgaze.pipeline.speed import SpeedSource, VehicleSpeed, no_speed, vehicle_speed
@@ -93,6 +97,8 @@ class Pipeline:
         self._clock = clock
         self._steps = DetectorSteps.of(detector)
         self._frame_received_s = math.nan
+        self._previous_grey: npt.NDArray[np.float32] | None = None
+        """The last frame's grey sample, for the frozen-frame check."""
 
     @classmethod
     def from_config(
@@ -130,11 +136,13 @@ class Pipeline:
         driver = detection.driver
         yaw_raw_deg = self.pose.raw_yaw_deg(driver)
         # The matrix pitch's down gain starts at the monitor's current neutral pitch.
-        pitch_raw_deg = self.pose.raw_pitch_deg(driver, self.monitor.state.neutral_pitch_deg)
+        pitch_raw_deg = self.pose.raw_pitch_deg(driver, self.monitor.camera_neutral_pitch_deg)
         eyes = driver_eyes(driver, yaw_raw_deg, self.eyes)
         after_geometry = clock()
         sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg, pitch_raw_deg)
         sample = sample if eyes is None else replace(sample, eyes=eyes)
+        frame_check, self._previous_grey = check_frame(frame.image, self._previous_grey)
+        sample = replace(sample, frame_check=frame_check)
         after_smoothing = clock()
         alerts = self.monitor.update(sample, self.speed.kmh_at(frame.t_s))
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)

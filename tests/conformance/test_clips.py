@@ -3,6 +3,7 @@ face, sunglasses, the face as a camera at a mounting preset sees it, the speed t
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +40,7 @@ def test_camera_states_and_noise(renderer: ScenarioRenderer) -> None:
     frames = list(renderer.frames(Scenario("states", "", segments, 70.0, ())))
     assert len(frames) == 16
     ahead = [grey(f) for f in frames[:5]]
-    for first, second in zip(ahead, ahead[1:], strict=False):
+    for first, second in itertools.pairwise(ahead):
         assert np.abs(first - second).mean() > 1.0  # a held pose is not a frozen camera
     assert all(np.array_equal(frame, frames[4]) for frame in frames[5:10])  # frozen: repeats
     for frame in frames[10:13]:
@@ -79,5 +80,8 @@ def test_side_files_and_the_source(renderer: ScenarioRenderer, tmp_path: Path) -
     frames = list(RenderedSource(renderer, scenario, clip))
     assert [f.t_s for f in frames] == pytest.approx([0.0, 0.2, 0.4, 0.6, 0.8, 1.0])
     assert clip.stat().st_size > 0
-    assert renderer.write_side_files(Scenario("drive", "", (Segment(1.0),), None, ()), tmp_path) is None
+    assert (
+        renderer.write_side_files(Scenario("drive", "", (Segment(1.0),), None, ()), tmp_path)
+        is None
+    )
     assert not track.exists()  # no speed: no track (unknown)

@@ -34,3 +34,28 @@ def test_scenario_starts_and_duration() -> None:
     assert scenario.start_of("look") == 3.0 and scenario.start_of("back") == 7.0
     with pytest.raises(KeyError, match="no segment labelled 'event'"):
         scenario.start_of("event")
+
+
+@pytest.mark.parametrize("protocol", ["addw", "euroncap", "both"])
+def test_the_matrix_covers_the_issue_and_every_clock_has_its_start(protocol: str) -> None:
+    from roadgaze.config import Config
+    from roadgaze.conformance.matrix import scenario_matrix
+
+    monitor = Config().monitor.model_copy(update={"protocol": protocol})
+    scenarios = scenario_matrix(monitor)
+    names = {s.name for s in scenarios}
+    assert {"lap_70", "side_left_70", "side_right_70", "mirror_left_70", "lap_8s_10"} <= names
+    assert 6 <= sum(s.fast for s in scenarios) <= 10
+    assert len(names) == len(scenarios)
+    for scenario in scenarios:
+        assert scenario.duration_s <= 25.0
+        for requirement in scenario.requirements:
+            start_s = scenario.start_of(requirement.from_label)
+            assert 0.0 < start_s < scenario.duration_s
+            if requirement.window_s is not None:
+                assert start_s + requirement.window_s[1] < scenario.duration_s
+    by_name = {s.name: s for s in scenarios}
+    assert by_name["lap_8s_10"].speed_kmh == 10.0 and by_name["lap_unknown_speed"].speed_kmh is None
+    # The windows follow the rule tables: ADDW alone waits 6 s at 35 km/h, Euro NCAP 3 s.
+    lap_35 = by_name["lap_35"].requirements[0].window_s
+    assert lap_35 == pytest.approx((4.5, 6.6) if protocol == "addw" else (1.5, 3.6))

@@ -53,6 +53,11 @@ def register(subparsers: Any) -> None:
         "--fast", action="store_true", help="only the fast subset (the test suite's, ~8 drives)"
     )
     parser.add_argument(
+        "--save-clips",
+        action="store_true",
+        help="also write each drive's video (DIR/clips/NAME.mkv, lossless) for `roadgaze replay`",
+    )
+    parser.add_argument(
         "--only",
         action="append",
         metavar="NAME",
@@ -70,9 +75,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
 
     if args.protocol is not None:
         monitor = config.monitor.model_dump() | {"protocol": args.protocol}
-        config = config.model_copy(
-            update={"monitor": type(config.monitor).model_validate(monitor)}
-        )
+        config = config.model_copy(update={"monitor": type(config.monitor).model_validate(monitor)})
     protocol = config.monitor.protocol
     scenarios = scenario_matrix(config.monitor)
     if args.fast:
@@ -97,7 +100,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
         )
         log.info("conformance: %s %s (%s)", verdict, scenario.name, measured)
 
-    suite = run_suite(scenarios, config, out_dir / "clips", renderer, progress)
+    suite = run_suite(scenarios, config, out_dir / "clips", renderer, progress, args.save_clips)
     print(markdown_table(suite.outcomes), flush=True)
     log.info("conformance: %s", summary_line(suite, protocol))
     for path in write_reports(suite, protocol, FPS, out_dir):

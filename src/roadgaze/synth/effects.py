@@ -28,12 +28,11 @@ LENS_WIDTH_EYE_WIDTHS = 1.7
 LENS_BGR = (22, 20, 18)
 
 
-def sensor_noise(
-    frame: ImageBGR, rng: np.random.Generator, sigma: float = NOISE_SIGMA
-) -> ImageBGR:
+def sensor_noise(frame: ImageBGR, rng: np.random.Generator, sigma: float = NOISE_SIGMA) -> ImageBGR:
     """`frame` with Gaussian noise of `sigma` grey levels added per pixel, clipped to 0-255."""
     noisy = frame.astype(np.float32) + rng.normal(0.0, sigma, frame.shape).astype(np.float32)
-    return np.clip(noisy + 0.5, 0, 255).astype(np.uint8)
+    out: ImageBGR = np.clip(noisy + 0.5, 0, 255).astype(np.uint8)
+    return out
 
 
 class NoiseBank:
@@ -62,8 +61,9 @@ class NoiseBank:
 
         index = self._next
         self._next = (index + 1) % len(self._up)
-        out: ImageBGR = cv2.subtract(cv2.add(frame, self._up[index]), self._down[index])
-        return out
+        return np.asarray(
+            cv2.subtract(cv2.add(frame, self._up[index]), self._down[index]), dtype=np.uint8
+        )
 
 
 def covered_frame(size: tuple[int, int], rng: np.random.Generator) -> ImageBGR:
@@ -99,9 +99,7 @@ def sunglasses(
         )
         dx, dy = points[eye.outer, :2] - points[eye.inner, :2]
         angle = float(np.degrees(np.arctan2(dy, dx)))
-        cv2.ellipse(
-            out, (round(centre[0]), round(centre[1])), axes, angle, 0, 360, LENS_BGR, -1
-        )
+        cv2.ellipse(out, (round(centre[0]), round(centre[1])), axes, angle, 0, 360, LENS_BGR, -1)
         inner.append((round(points[eye.inner, 0]), round(points[eye.inner, 1])))
     if len(inner) == 2:
         thickness = max(2, round(0.02 * renderer.mesh.face_width_px))

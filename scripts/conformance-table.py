@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 """Regenerate the README's conformance table (between its `conformance:start/end` markers).
 
-    .venv/bin/python scripts/conformance-table.py [--out DIR] [--protocol P] [--check]
+    .venv/bin/python scripts/conformance-table.py [--out DIR] [--protocol P] [--check] [--from DIR]
 
 Runs `roadgaze conformance --out DIR` (the full matrix; a few minutes on a 2-core machine) with
 the `roadgaze` of the Python that runs this script, then writes DIR/conformance.md's table and
 its summary line into README.md. `--check` only says whether the README's table is the one
 measured (exit 1 when not). The run's own exit status (1 on any FAIL) is passed on after the
 README is written, so a failing requirement is visible in the table and in the exit code.
+`--from DIR` takes the table of a finished `roadgaze conformance --out DIR` instead of running.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import argparse
 import json
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -51,19 +53,26 @@ def table_rows(text: str) -> list[str]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--out", type=Path, default=REPO / "conformance-run", metavar="DIR")
+    default_out = Path(tempfile.gettempdir()) / "roadgaze-conformance"
+    parser.add_argument("--out", type=Path, default=default_out, metavar="DIR")
     parser.add_argument("--protocol", choices=["addw", "euroncap", "both"])
     parser.add_argument("--check", action="store_true", help="compare only, write nothing")
+    parser.add_argument("--from", dest="done", type=Path, metavar="DIR", help="a finished run")
     args = parser.parse_args()
-    command = [sys.executable, "-m", "roadgaze", "conformance", "--out", str(args.out)]
-    if args.protocol:
-        command += ["--protocol", args.protocol]
-    print("conformance-table: $ " + " ".join(command[2:]), file=sys.stderr, flush=True)
-    code = subprocess.run(command, stdout=subprocess.DEVNULL, check=False).returncode
-    if code not in (0, 1):
-        raise SystemExit(f"conformance-table: roadgaze conformance failed (exit {code})")
+    out_dir = args.done or args.out
+    if args.done is None:
+        command = [sys.executable, "-m", "roadgaze", "conformance", "--out", str(args.out)]
+        if args.protocol:
+            command += ["--protocol", args.protocol]
+        print("conformance-table: $ " + " ".join(command[2:]), file=sys.stderr, flush=True)
+        code = subprocess.run(command, stdout=subprocess.DEVNULL, check=False).returncode
+        if code not in (0, 1):
+            raise SystemExit(f"conformance-table: roadgaze conformance failed (exit {code})")
+    else:
+        report = json.loads((out_dir / "conformance.json").read_text(encoding="utf-8"))
+        code = 1 if report["failed"] else 0
     text = README.read_text(encoding="utf-8")
-    new_text = replace_block(text, block(args.out))
+    new_text = replace_block(text, block(out_dir))
     if args.check:
         same = table_rows(new_text) == table_rows(text)
         verdict = "matches" if same else "differs from"

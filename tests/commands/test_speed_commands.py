@@ -15,8 +15,8 @@ from roadgaze.cli import main
 
 pytestmark = pytest.mark.usefixtures("restore_logging")
 
-LAP_LOOK = "0:1.5,-35:4,0:1.5"
-"""Away to the right for 4 s: a long distraction when moving."""
+LAP_LOOK = "0:1.5,0/-35:4,0:1.5"
+"""Into the lap for 4 s: a long distraction when moving."""
 
 
 @pytest.fixture(scope="module")

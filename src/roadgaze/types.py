@@ -260,6 +260,9 @@ class Verdict:
     when none is active."""
     distraction_rule: str = ""
     """The rule giving `distraction_warn_s` (e.g. `euroncap.long_distraction`)."""
+    camera_neutral_deg: tuple[float, float] | None = None
+    """The road-ahead (yaw, pitch) as the camera sees it, for a camera not in front (the monitor's
+    angles are in the driver's frame: roadgaze.pose.mounting); None: the same as the neutral."""
 
     @property
     def eyes_on_road(self) -> bool | None:

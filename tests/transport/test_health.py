@@ -44,13 +44,14 @@ def records(
         yield FrameRecord(sample(t_s, yaw_deg), monitor.verdict, alerts)
 
 
-AWAY_YAW_DEG = -30.0
+AWAY_YAW_DEG = -27.0
 """Right of the road, short of the right mirror: zone `away` (+45 deg is the left mirror, which
-raises no long_distraction)."""
+raises no long_distraction; -30 was away before ADDW's mirror bounds made it the right mirror's
+edge)."""
 
 
 def glance(frames: int) -> list[tuple[float, float | None]]:
-    """1 s ahead, 4 s at -30 deg (zone away), then ahead, at 30 fps."""
+    """1 s ahead, 4 s at -27 deg (zone away), then ahead, at 30 fps."""
     return [(f / 30, AWAY_YAW_DEG if 1.0 <= f / 30 < 5.0 else 0.0) for f in range(frames)]
 
 
@@ -137,7 +138,9 @@ def test_state_is_degraded_while_the_eyes_have_been_unavailable_ten_seconds() ->
             jsonschema.validate(json.loads(state.to_json_bytes()), SCHEMAS["state"])
     state = health.state_message()
     assert (state.status, state.problems, state.monitor.eyes) == ("running", [], "open")
-    assert [a.kind for a in health.recent_alerts] == ["degraded", "cleared"]
+    # Euro NCAP needs the eyes: unjudgeable eyes are also a temporary failure (alert/3)
+    kinds = [a.kind for a in health.recent_alerts]
+    assert kinds == ["degraded", "temporary_failure", "cleared"]
 
 
 @pytest.mark.parametrize(

@@ -8,8 +8,8 @@ saturated fraction and mean absolute difference from the previous frame's sample
 3.5.2; docs/monitor.md, "Failures"), each timed while the vehicle moves:
 
 - frames black (mean grey below `frame_dark_mean`), blocked (spread below `frame_min_std`: a
-  covered lens) or saturated (more than `frame_saturated_fraction` at 250 or more: blinded) for
-  `frame_failure_s`;
+  covered lens) or saturated (more than `frame_saturated_fraction` at 250 or more: blinded), with
+  no judgeable face, for `frame_failure_s` (a dark image that still shows a face is working);
 - frames frozen (differing from the previous one by at most `frozen_max_diff` grey levels) for
   `frozen_failure_s`;
 - no judgeable face (none, or one whose yaw the model cannot explain) for `no_face_failure_s`;
@@ -108,6 +108,8 @@ def step_failures(
     diff = None if check is None else check.diff_grey
     frozen = diff is not None and diff <= config.frozen_max_diff
     no_face = not sample.face or (sample.yaw_raw_deg is None and sample.yaw_deg is None)
+    # A dark or flat image that still shows a judgeable face (night, infrared) is working.
+    issue = issue if no_face else ""
     issue_since = _since(moving and bool(issue), state.issue_since_s, t_s)
     if issue != state.issue:
         issue_since = t_s if moving and issue else None

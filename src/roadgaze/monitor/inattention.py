@@ -334,7 +334,15 @@ def verdict_of(config: MonitorConfig, state: MonitorState) -> Verdict:
         failure=state.failures.reason,
         distraction_warn_s=state.warn_s,
         distraction_rule=state.warn_rule,
+        camera_neutral_deg=_camera_neutral(config, state),
     )
+
+
+def _camera_neutral(config: MonitorConfig, state: MonitorState) -> tuple[float, float] | None:
+    mounting = config.mounting()
+    if mounting.is_identity:
+        return None
+    return gaze_to_camera(mounting, state.neutral_yaw_deg, state.neutral_pitch_deg)
 
 
 class Monitor:
@@ -357,11 +365,8 @@ class Monitor:
     def camera_neutral_pitch_deg(self) -> float:
         """The learned road-ahead pitch as the camera sees it (the pose stage's down gain starts
         there); the neutral itself is in the driver's frame."""
-        if self.mounting.is_identity:
-            return self.state.neutral_pitch_deg
-        return gaze_to_camera(
-            self.mounting, self.state.neutral_yaw_deg, self.state.neutral_pitch_deg
-        )[1]
+        camera = _camera_neutral(self.config, self.state)
+        return self.state.neutral_pitch_deg if camera is None else camera[1]
 
     @property
     def verdict(self) -> Verdict:

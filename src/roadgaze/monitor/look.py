@@ -103,7 +103,13 @@ def classify(
                     (eyes.gaze_pitch_deg or 0.0) - state.neutral_pitch_deg,
                     state.face_zone,
                 )
-                if gaze_zone != ROAD or zone == ROAD:
+                # Nor into a driving-related zone from one that is not (a look out of the side
+                # window read as a mirror glance: the rendered A-pillar drive read the eyes
+                # turned back 10 deg at a 60 deg head turn, test_mounting_end_to_end).
+                excused_head = zone == ROAD or zones.is_driving_related(zone)
+                if (gaze_zone != ROAD or zone == ROAD) and (
+                    excused_head or not zones.is_driving_related(gaze_zone)
+                ):
                     gaze = Gaze.ON_ROAD if gaze_zone == ROAD else Gaze.OFF_ROAD
                     return Look(gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, by_eyes=True)
         gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD

@@ -59,3 +59,14 @@ def test_the_matrix_covers_the_issue_and_every_clock_has_its_start(protocol: str
     # The windows follow the rule tables: ADDW alone waits 6 s at 35 km/h, Euro NCAP 3 s.
     lap_35 = by_name["lap_35"].requirements[0].window_s
     assert lap_35 == pytest.approx((4.5, 6.6) if protocol == "addw" else (1.5, 3.6))
+    # A rule of a protocol not configured is measured, not judged.
+    assert by_name["vats_70"].requirements[0].applies is (protocol != "addw")
+    assert by_name["covered_70"].requirements[0].applies is (protocol != "euroncap")
+
+
+def test_a_requirement_that_does_not_apply_passes_and_says_so() -> None:
+    from roadgaze.conformance.model import Outcome
+
+    other = Requirement("r", "t", "s", ("vats",), (1.0, 2.0), "look", applies=False)
+    assert judge(other, 0.0, []) == (None, True)
+    assert Outcome("s", other, None, True).to_json()["result"] == "N/A"

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from roadgaze.config import MonitorConfig
 from roadgaze.conformance.model import Requirement
-from roadgaze.monitor.protocols import Rule, Trigger, addw, distraction_trigger, euroncap
+from roadgaze.monitor.protocols import Rule, Trigger, addw, distraction_trigger, euroncap, uses
 
 LATENCY_S = 0.6
 """How much later than the rule's time a warning may come, measured from the start of the look:
@@ -31,6 +31,12 @@ DISTRACTION = ("long_distraction",)
 
 def source_of(rule: Rule) -> str:
     return f"{rule.key} ({rule.config_key}): {rule.source}"
+
+
+def applies(config: MonitorConfig, rule: Rule) -> bool:
+    """Whether the configured protocols ask for `rule` (roadgaze's own rules always apply)."""
+    protocol = rule.key.split(".", 1)[0]
+    return protocol not in ("addw", "euroncap") or uses(config, protocol)
 
 
 def trigger_at(config: MonitorConfig, speed_kmh: float | None) -> Trigger | None:
@@ -91,4 +97,4 @@ def timer(
         raise ValueError(f"rule {rule.key}: {rule.config_key} is not set")
     expected_s = value + offset_s
     window = (expected_s - TIMER_EARLY_S, expected_s + LATENCY_S)
-    return Requirement(key, text, source_of(rule), kinds, window, from_label)
+    return Requirement(key, text, source_of(rule), kinds, window, from_label, applies(config, rule))

@@ -41,7 +41,9 @@ class Requirement:
 
     `kinds` are alert kinds (`AlertKind` values); the first alert of any of them, measured from
     the start of the segment labelled `from_label`, must fall within `window_s` (seconds,
-    inclusive); with `window_s` None no such alert may be raised anywhere in the drive."""
+    inclusive); with `window_s` None no such alert may be raised anywhere in the drive. A
+    requirement of a protocol that is not configured does not apply: it is measured and shown,
+    not judged."""
 
     key: str
     text: str
@@ -49,6 +51,7 @@ class Requirement:
     kinds: tuple[str, ...]
     window_s: tuple[float, float] | None
     from_label: str = "look"
+    applies: bool = True
 
 
 @dataclass(frozen=True, slots=True)
@@ -93,6 +96,13 @@ class Outcome:
     alerts: tuple[str, ...] = field(default=())
     """Every alert of the drive as `kind:level@t` (for the report's detail)."""
 
+    @property
+    def result(self) -> str:
+        """PASS, FAIL, or N/A for a requirement that does not apply."""
+        if not self.requirement.applies:
+            return "N/A"
+        return "PASS" if self.passed else "FAIL"
+
     def to_json(self) -> dict[str, Any]:
         window = self.requirement.window_s
         return {
@@ -103,7 +113,7 @@ class Outcome:
             "kinds": list(self.requirement.kinds),
             "expected_window_s": None if window is None else [round(w, 3) for w in window],
             "measured_s": None if self.measured_s is None else round(self.measured_s, 3),
-            "result": "PASS" if self.passed else "FAIL",
+            "result": self.result,
             "alerts": list(self.alerts),
         }
 
@@ -112,10 +122,12 @@ def judge(
     requirement: Requirement, start_s: float, alerts: list[tuple[str, str, float]]
 ) -> tuple[float | None, bool]:
     """(measured, passed) for `alerts` (kind, level, t_s) against `requirement`, whose clock
-    starts at `start_s`."""
+    starts at `start_s`; a requirement that does not apply passes."""
     times = [t_s for kind, _, t_s in alerts if kind in requirement.kinds]
     measured = min(times) - start_s if times else None
     window = requirement.window_s
+    if not requirement.applies:
+        return measured, True
     if window is None:
         return measured, measured is None
     if measured is None or not math.isfinite(measured):

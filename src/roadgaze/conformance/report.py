@@ -32,7 +32,7 @@ def row(outcome: Outcome) -> str:
         outcome.requirement.source,
         _window(outcome),
         _measured(outcome),
-        "PASS" if outcome.passed else "**FAIL**",
+        "**FAIL**" if outcome.result == "FAIL" else outcome.result,
     )
     return "| " + " | ".join(cell.replace("|", "\\|") for cell in cells) + " |"
 
@@ -43,10 +43,12 @@ def markdown_table(outcomes: tuple[Outcome, ...] | list[Outcome]) -> str:
 
 def summary_line(run: SuiteRun, protocol: str) -> str:
     failed = len(run.failed)
-    total = len(run.outcomes)
+    judged = sum(outcome.requirement.applies for outcome in run.outcomes)
+    other = len(run.outcomes) - judged
     return (
-        f"protocol {protocol}: {total - failed} of {total} requirements PASS, {failed} FAIL, "
-        f"{run.scenarios} scenarios in {run.wall_s:.0f} s"
+        f"protocol {protocol}: {judged - failed} of {judged} requirements PASS, {failed} FAIL"
+        + (f", {other} of other protocols not judged (N/A)" if other else "")
+        + f"; {run.scenarios} scenarios in {run.wall_s:.0f} s"
     )
 
 
@@ -55,7 +57,8 @@ def to_json(run: SuiteRun, protocol: str, fps: float) -> dict[str, Any]:
         "protocol": protocol,
         "fps": fps,
         "scenarios": run.scenarios,
-        "requirements": len(run.outcomes),
+        "requirements": sum(outcome.requirement.applies for outcome in run.outcomes),
+        "not_applicable": sum(not outcome.requirement.applies for outcome in run.outcomes),
         "failed": len(run.failed),
         "wall_s": round(run.wall_s, 1),
         "outcomes": [outcome.to_json() for outcome in run.outcomes],

@@ -46,7 +46,12 @@ def vats_scenarios(config: MonitorConfig) -> list[Scenario]:
     )
     text = f"{count - 1} glances of {VATS_GLANCE_S:g} s within {config.vats_window_s:g} s: no VATS"
     quiet = Requirement(
-        "vats_below_70.quiet", text, expect.source_of(euroncap.VATS), ("vats",), None
+        "vats_below_70.quiet",
+        text,
+        expect.source_of(euroncap.VATS),
+        ("vats",),
+        None,
+        applies=expect.applies(config, euroncap.VATS),
     )
     short = expect.no_distraction(
         config, FAST_KMH, "vats_70.no_long", "each glance below the trigger: no long distraction"
@@ -77,6 +82,7 @@ def eye_scenarios(config: MonitorConfig) -> list[Scenario]:
         ("sleep",),
         None,
         "event",
+        expect.applies(config, euroncap.SLEEP),
     )
     sleep = expect.timer(
         config, euroncap.SLEEP, ("sleep",), "sleep_70.warns", "eyes closed 4 s at 70 km/h"

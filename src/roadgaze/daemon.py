@@ -23,7 +23,7 @@ from roadgaze.transport import BusPublisher, Health, Keys, SpeedInput, ZenohLink
 from roadgaze.transport.failure_watch import PermanentFailureWatch, failure_alert
 from roadgaze.transport.health import ALERT_LOG
 from roadgaze.transport.vss import VSS_PATHS, VssPublisher, vss_key
-from roadgaze.types import Alert
+from roadgaze.types import Alert, AlertKind
 
 log = logging.getLogger("roadgaze.daemon")
 
@@ -83,6 +83,8 @@ def _publish_failure(bus: BusOutputs, alert: Alert) -> None:
     for sink in bus.sinks:
         if isinstance(sink, BusPublisher):
             sink.publish_alert(alert)
+        elif isinstance(sink, VssPublisher):
+            sink.publish_failure(alert.kind is AlertKind.PERMANENT_FAILURE)
 
 
 def run_daemon(

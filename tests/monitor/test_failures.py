@@ -14,6 +14,7 @@ from roadgaze.monitor import Monitor
 from roadgaze.monitor.failures import FRAME_STRIDE, check_frame, frame_issue
 from roadgaze.transport import Health, Keys
 from roadgaze.transport.failure_watch import PermanentFailureWatch
+from roadgaze.transport.vss import VssPublisher
 from roadgaze.types import Alert, AlertKind, FrameCheck
 
 FPS = 15.0
@@ -147,3 +148,21 @@ def test_a_camera_lost_past_the_limit_is_a_permanent_failure_cleared_by_frames()
     cleared = watch.check()
     assert cleared is not None and cleared.clears == (AlertKind.PERMANENT_FAILURE,)
     assert health.state_message().permanent_failure == ""
+
+
+def test_a_permanent_failure_sets_the_vss_error_signal() -> None:
+    sent: list[tuple[str, bytes]] = []
+
+    class Link:
+        def publish_vss(self, key: str, payload: bytes) -> None:
+            sent.append((key, payload))
+
+    publisher = VssPublisher(Link(), CONFIG)
+    publisher.publish_failure(True)
+    publisher.publish_failure(False)
+    assert sent == [
+        ("Vehicle/ADAS/DMS/IsError", b"true"),
+        ("Vehicle/ADAS/DMS/IsWarning", b"true"),
+        ("Vehicle/ADAS/DMS/IsError", b"false"),
+        ("Vehicle/ADAS/DMS/IsWarning", b"false"),
+    ]

@@ -163,7 +163,8 @@ def test_alerts_are_gated_on_the_speed_received(
     link = FakeLink(speed=speed)
     keys = Keys.from_config(FIXED.zenoh)
     health = Health(FIXED, keys, link, "test")
-    yaws: list[float | None] = [AWAY_YAW_DEG if 1.0 <= f / 30 < 5.0 else 0.0 for f in range(180)]
+    # A scripted face at -30 reads -26.6 through the yaw model: zone away.
+    yaws: list[float | None] = [-30.0 if 1.0 <= f / 30 < 5.0 else 0.0 for f in range(180)]
     pipeline = Pipeline.from_config(FIXED, ScriptedDetector(yaws), speed=speed.kmh)
     pipeline.run(ListSource(len(yaws)), [health, BusPublisher(keys.vehicle_id, link)])
     assert len(link.alerts) == expected

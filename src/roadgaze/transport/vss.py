@@ -27,7 +27,8 @@ Values (definitions and how the levels are computed: docs/zenoh.md):
   `HeadPosition.Roll` > 0 = leaning to the right (the project's roll). Not sent when unknown.
 - `ADAS.DMS.IsWarning`: an alert is active; `ADAS.DMS.IsError`: monitoring degraded (the eyes
   unavailable too long) or a temporary failure in force (blocked, black, saturated or frozen
-  frames, no judgeable face; docs/monitor.md, "Failures").
+  frames, no judgeable face; docs/monitor.md, "Failures"); a permanent failure (camera gone)
+  sends `IsError` and `IsWarning` true when raised, false when cleared (`publish_failure`).
 """
 
 from __future__ import annotations
@@ -245,6 +246,13 @@ class VssPublisher:
                     continue
             self.link.publish_vss(self.keys[path], vss_text(value))
             self._sent[path] = (value, t_s)
+            self.published += 1
+
+    def publish_failure(self, failed: bool) -> None:
+        """Send `ADAS.DMS.IsError` (and `IsWarning`) now: a permanent failure raised or cleared
+        outside the frame loop, when no record comes to carry it."""
+        for path in (f"{DMS}.IsError", f"{DMS}.IsWarning"):
+            self.link.publish_vss(self.keys[path], vss_text(failed))
             self.published += 1
 
     def close(self) -> None:

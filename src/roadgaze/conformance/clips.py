@@ -62,8 +62,9 @@ def write_speed_track(path: Path, speed_kmh: float, duration_s: float) -> None:
 
 
 class ScenarioRenderer:
-    """Renders scenarios with one `EyeRenderer` (built once: it runs MediaPipe on the photo);
-    identical poses are rendered once per scenario."""
+    """Renders scenarios with one `EyeRenderer` (built once: it runs MediaPipe on the photo; give
+    it `eyeball_at_rest=True`, so eyes at rest turn with the head as an eyeball does); identical
+    poses are rendered once per scenario."""
 
     def __init__(self, renderer: EyeRenderer, fps: float, cabin: str = "lhd") -> None:
         self.renderer = renderer

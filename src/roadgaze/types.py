@@ -116,7 +116,8 @@ class FrameCheck:
     saturated_fraction: float
     """Fraction of the sampled pixels at 250 or more."""
     diff_grey: float | None
-    """Mean absolute grey difference from the previous frame; None for the first."""
+    """Largest absolute grey difference of a sample from the previous frame's; None for the
+    first."""
 
 
 @dataclass(frozen=True, slots=True)

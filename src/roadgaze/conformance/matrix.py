@@ -173,7 +173,10 @@ def distraction_scenarios(config: MonitorConfig) -> list[Scenario]:
             fast=True,
         )
     )
-    mirror_source = f"mirrors are driving-related ({expect.source_of(addw.AREA_YAW)})"
+    mirror_source = (
+        "mirror glances are driving-related (driving_related_zones); distraction area 1 starts "
+        f"beyond them: {expect.source_of(addw.AREA_YAW)}"
+    )
     for side, fast in (("left", True), ("right", False)):
         target = zone_target(config, f"{side}_mirror")
         text = f"1.5 s {side} mirror glance at {fast_kmh_text}: no warning"

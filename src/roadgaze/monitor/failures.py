@@ -1,8 +1,8 @@
 """Failure warnings: what tells a failed camera from a driver. Pure (numpy only).
 
 `check_frame` measures one image cheaply: the green channel (most of luma) of every
-`FRAME_STRIDE`-th pixel in each direction (4,800 pixels of a 640x480 frame: 0.016 ms median,
-0.063 ms mean on this shared 2-core machine by `scripts/bench-frame-check.py`), its mean, spread,
+`FRAME_STRIDE`-th pixel in each direction (4,800 pixels of a 640x480 frame: 0.033 ms of CPU per
+frame on a shared 2-core machine, `scripts/bench-frame-check.py`), its mean, spread,
 saturated fraction and largest absolute difference from the previous frame's samples.
 `step_failures` turns those checks and the face into a temporary failure (EU 2023/2590 Annex I
 3.5.2; docs/monitor.md, "Failures"), each timed while the vehicle moves:

@@ -4,7 +4,6 @@ and the permanent failure watch."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 import pytest
@@ -173,16 +172,7 @@ def test_the_pipeline_checks_every_frame_a_repeated_frame_is_frozen() -> None:
     """Through the loop: 11 s of one blank frame with a face read as road (at 30 fps)."""
     from fakes import ListSource, ScriptedDetector
     from roadgaze.pipeline import Pipeline
-
-    class Collect:
-        def __init__(self) -> None:
-            self.records: list[Any] = []
-
-        def on_record(self, record: Any, frame: Any) -> None:
-            self.records.append(record)
-
-        def close(self) -> None:
-            return None
+    from test_pipeline_synthetic import Collect
 
     collect = Collect()
     Pipeline.from_config(Config(), ScriptedDetector([0.0] * 330)).run(ListSource(330), [collect])

@@ -346,3 +346,29 @@ def die_on_crash_drives(task: Any) -> Any:
     if task.drive.drive_id.startswith("crash"):
         os._exit(70)
     return DriveResult.of(task.drive, "ok", frames=1, duration_s=0.1)
+
+
+def drive_monitor(
+    monitor: Any,
+    pose_at: Any,
+    speed_kmh: float | None,
+    duration_s: float,
+    fps: float = 15.0,
+    frame_check_at: Any = None,
+) -> list[Any]:
+    """Feed `monitor` (a `Monitor`) samples at `fps`: `pose_at(t_s) -> (yaw or None for no face,
+    pitch)`, open eyes with a face, `frame_check_at(t_s)` the frame's checks; the alerts raised."""
+    from roadgaze.types import PoseSample
+
+    alerts: list[Any] = []
+    for frame in range(round(duration_s * fps)):
+        t_s = frame / fps
+        yaw, pitch = pose_at(t_s)
+        face = yaw is not None
+        check = None if frame_check_at is None else frame_check_at(t_s)
+        sample = PoseSample(
+            t_s, frame, face, yaw, yaw, 0.0, 1.0, None, int(face), pitch, pitch,
+            eyes=open_eyes() if face else None, frame_check=check,
+        )  # fmt: skip
+        alerts.extend(monitor.update(sample, speed_kmh))
+    return alerts

@@ -17,6 +17,7 @@ PURE_MODULES = (
     "roadgaze.types",
     "roadgaze.pose.geometry",
     "roadgaze.pose.smoothing",
+    "roadgaze.pose.mounting",
     "roadgaze.pose",
     "roadgaze.monitor",
     "roadgaze.monitor.eyes",

@@ -70,8 +70,8 @@ def check(raw: bytes, vehicle_id: str) -> dict | str:
         alert = json.loads(raw.decode("utf-8"))
     except (RecursionError, UnicodeDecodeError, ValueError) as exc:
         return f"not JSON ({type(exc).__name__})"
-    if not isinstance(alert, dict) or alert.get("schema") != "roadgaze.alert/2":
-        return "not a roadgaze.alert/2"
+    if not isinstance(alert, dict) or alert.get("schema") != "roadgaze.alert/3":
+        return "not a roadgaze.alert/3"
     if alert.get("vehicle_id") != vehicle_id:
         return "another vehicle's id"
     if type(alert.get("seq")) is not int or alert["seq"] < 0:

@@ -19,11 +19,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from roadgaze.config import Config
+from roadgaze.errors import RoadgazeError
 from roadgaze.pipeline import Sink, SpeedSource, no_speed
 from roadgaze.service.signals import StopFlag, signal_handlers
 from roadgaze.transport import BusPublisher, Health, Keys, SpeedInput, ZenohLink
+from roadgaze.transport.failure_watch import PermanentFailureWatch, failure_alert
 from roadgaze.transport.health import ALERT_LOG
 from roadgaze.transport.vss import VSS_PATHS, VssPublisher, vss_key
+from roadgaze.types import Alert, AlertKind
 
 log = logging.getLogger("roadgaze.daemon")
 
@@ -105,6 +108,16 @@ def _report_undelivered(link: ZenohLink, health: Health, logger: logging.Logger)
     )
 
 
+def _publish_failure(bus: BusOutputs, alert: Alert) -> None:
+    """Count, log and (when publishing) send an alert raised outside the frame loop."""
+    bus.health.note_alert(alert)
+    for sink in bus.sinks:
+        if isinstance(sink, BusPublisher):
+            sink.publish_alert(alert)
+        elif isinstance(sink, VssPublisher):
+            sink.publish_failure(alert.kind is AlertKind.PERMANENT_FAILURE)
+
+
 def run_daemon(
     config: Config,
     source_spec: str,
@@ -148,10 +161,18 @@ def run_daemon(
             extra = (stack.enter_context(recorder),)
         # The model loads before the camera opens, so no frame waits for MediaPipe.
         supervisor.status("loading the face landmarker model")
-        detector = stack.enter_context(closing(create_detector(config)))
+        try:
+            detector = stack.enter_context(closing(create_detector(config)))
+        except RoadgazeError as exc:  # told on the bus before the one-line error
+            _publish_failure(bus, failure_alert(0.0, f"model unusable: {exc}"))
+            raise
         supervisor.status(f"opening {source_spec}")
         source = stack.enter_context(capture.open_source(source_spec, config, wait_for_camera=True))
         health.source = source
+        watch = PermanentFailureWatch(
+            health, lambda alert: _publish_failure(bus, alert), config.monitor.permanent_failure_s
+        )
+        stack.callback(watch.start().close)
         supervisor.watch(source, source_spec)
         log.info(
             "roadgaze run: source %s, vehicle %s, prefix %s",

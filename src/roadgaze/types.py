@@ -110,6 +110,22 @@ class SmoothedAngle:
 
 
 @dataclass(frozen=True, slots=True)
+class FrameCheck:
+    """Cheap statistics of one frame's grey image, sampled every few pixels
+    (`roadgaze.monitor.failures.check_frame`): what tells a failed camera from a driver."""
+
+    mean_grey: float
+    """Mean grey level, 0-255."""
+    std_grey: float
+    """Grey-level standard deviation: low for a covered lens or a flat image."""
+    saturated_fraction: float
+    """Fraction of the sampled pixels at 250 or more."""
+    diff_grey: float | None
+    """Largest absolute grey difference of a sample from the previous frame's; None for the
+    first."""
+
+
+@dataclass(frozen=True, slots=True)
 class PoseSample:
     """What the landmark and pose stages made of one frame: the monitor's input."""
 
@@ -132,6 +148,8 @@ class PoseSample:
     """Eye-line roll of this frame (> 0 = counter-clockwise in the image); None without a face."""
     eyes: EyesFeatures | None = None
     """The driver's eyes (roadgaze.landmarks.eyes); None without a face or eye measurement."""
+    frame_check: FrameCheck | None = None
+    """The image's cheap checks (dark, flat, saturated, repeated); None when not measured."""
 
 
 class AlertKind(StrEnum):
@@ -146,6 +164,11 @@ class AlertKind(StrEnum):
     UNRESPONSIVE = "unresponsive"
     DEGRADED = "degraded"
     """Monitoring impaired: the eyes have been unavailable too long (head pose only)."""
+    TEMPORARY_FAILURE = "temporary_failure"
+    """The camera cannot judge the driver for now (blocked, black, saturated or frozen frames, no
+    judgeable face while moving); `reason` says which. Cleared once recovered."""
+    PERMANENT_FAILURE = "permanent_failure"
+    """The service cannot monitor at all (camera gone past the reconnect limit, model unusable)."""
     CLEARED = "cleared"
 
 
@@ -172,7 +195,8 @@ class Alert:
     level: AlertLevel
     t_s: float
     yaw_deg: float | None
-    """Yaw relative to the camera (not to neutral) at the event; None without a face."""
+    """Head yaw at the event in the driver's frame (the camera's, with the camera in front: see
+    `[monitor] camera_mounting`), not relative to the neutral; None without a face."""
     off_road_s: float
     """Length of the current continuous off-road episode (for `cleared`: of the one just ended)."""
     window_off_road_s: float
@@ -188,6 +212,10 @@ class Alert:
     """Fraction of the last `perclos_window_s` with the eyes closed; None until enough is known."""
     reason: str = ""
     """Why the alert fired, in a few words (e.g. 'eyes closed', 'not back on road')."""
+    rule: str = ""
+    """The protocol rule it fired by (e.g. `addw.distraction.above_50kmh`, docs/monitor.md)."""
+    source: str = ""
+    """Where that rule comes from (e.g. `EU 2023/2590 Annex I 3.3.2`)."""
 
     @property
     def label(self) -> str:
@@ -203,9 +231,10 @@ class Verdict:
     on_road: bool | None
     """Road ahead; None when the gaze is unknown (no face, not explained by a turn away)."""
     yaw_deg: float | None
-    """The yaw judged (smoothed, else raw); None without a face or a usable yaw."""
+    """The yaw judged (smoothed, else raw) in the driver's frame (the camera mounting applied;
+    the camera's with the camera in front); None without a face or a usable yaw."""
     neutral_yaw_deg: float
-    """The road-ahead yaw the monitor measures against (fixed or learned)."""
+    """The road-ahead yaw the monitor measures against (fixed or learned), driver's frame."""
     off_road_s: float
     """Length of the current counted (off road and moving) episode."""
     window_off_road_s: float
@@ -232,6 +261,16 @@ class Verdict:
     long-distraction timer."""
     eyes: EyesVerdict = field(default_factory=EyesVerdict)
     """The eyes: open, closed or unavailable, gaze, closure, PERCLOS, blinks."""
+    failure: str = ""
+    """The temporary failure in force ('' for none), e.g. 'frames frozen 10.0 s'."""
+    distraction_warn_s: float | None = None
+    """The distraction time that warns at this speed under the configured protocol(s); None
+    when none is active."""
+    distraction_rule: str = ""
+    """The rule giving `distraction_warn_s` (e.g. `euroncap.long_distraction`)."""
+    camera_neutral_deg: tuple[float, float] | None = None
+    """The road-ahead (yaw, pitch) as the camera sees it, for a camera not in front (the monitor's
+    angles are in the driver's frame: roadgaze.pose.mounting); None: the same as the neutral."""
 
     @property
     def eyes_on_road(self) -> bool | None:

@@ -24,7 +24,7 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     assert {"yaw_deg", "off_road_s"} <= set(schemas["alert"]["properties"])
     yaw_fields = {"schema", "vehicle_id", "seq", "t_s", "frame", "face", "yaw_deg", "yaw_raw_deg"}
     assert yaw_fields | {"on_road"} <= set(schemas["yaw"]["properties"])
-    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/2"
+    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/3"
     # roadgaze.yaw/2 extends /1 with the pose and the zone; every field is always published
     new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
     assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
@@ -42,6 +42,13 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     kinds = set(schemas["alert"]["$defs"]["AlertKind"]["enum"])
     assert {"microsleep", "sleep", "drowsy", "unresponsive", "degraded"} <= kinds
     assert {"closure_s", "perclos", "reason"} <= set(schemas["alert"]["required"])
+    # alert/3: the failure kinds and the protocol rule; state/4: protocol, failures
+    assert {"temporary_failure", "permanent_failure"} <= kinds
+    assert {"rule", "source"} <= set(schemas["alert"]["required"])
+    assert {"protocol", "distraction_warn_s", "distraction_rule", "failure"} <= set(
+        snapshot["required"]
+    )
+    assert "permanent_failure" in schemas["state"]["required"]
 
 
 def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:

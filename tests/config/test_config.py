@@ -104,7 +104,8 @@ def test_zones_come_from_the_configuration_road_first() -> None:
     config = load_config(
         overrides={
             "monitor.road_half_width_deg": "30",
-            "monitor.zones": "[{name = 'rear_mirror', yaw_deg = [-40, -15], pitch_deg = [5, 30]}]",
+            # pitch up to 20 (30 before ADDW's roof: a driving-related zone may not reach it)
+            "monitor.zones": "[{name = 'rear_mirror', yaw_deg = [-40, -15], pitch_deg = [5, 20]}]",
             "monitor.driving_related_zones": "['rear_mirror']",
         },
         environ={},
@@ -115,7 +116,7 @@ def test_zones_come_from_the_configuration_road_first() -> None:
     assert (road.yaw_min_deg, road.yaw_max_deg) == (-25.0, 25.0)  # left at 30, entered at 25
     assert (road.pitch_min_deg, road.pitch_max_deg) == (-10.0, 15.0)
     assert zones.driving_related == frozenset({"rear_mirror"})
-    assert zones.names == ("road", "rear_mirror", "away")
+    assert zones.names == ("road", "rear_mirror", "far_left", "far_right", "roof", "away")
 
 
 def test_bad_set_syntax_is_reported() -> None:

@@ -64,9 +64,10 @@ def run(
     return monitor, alerts
 
 
-AWAY_YAW_DEG = -30.0
+AWAY_YAW_DEG = -27.0
 """A glance to the driver's right, short of the right mirror: zone `away` (not driving-related).
-(Before zones the timing tests glanced to +45 deg, which the default zones call `left_mirror`.)"""
+(Before zones the timing tests glanced to +45 deg, which the default zones call `left_mirror`;
+before ADDW's mirror bounds to -30, which is now the right mirror's edge.)"""
 
 
 def glances(
@@ -395,7 +396,7 @@ def segments(*parts: tuple[float, Pose]) -> Callable[[float], Pose]:
 
 ROAD_POSE = (0.0, 0.0)
 LEFT_MIRROR = (45.0, 0.0)
-RIGHT_MIRROR = (-60.0, 0.0)
+RIGHT_MIRROR = (-45.0, 0.0)  # -60 before ADDW's area 1 (beyond 55 deg: always distraction)
 AWAY_POSE = (AWAY_YAW_DEG, 0.0)
 LAP = (0.0, -35.0)
 
@@ -443,7 +444,7 @@ def test_mirror_glances_count_for_vats() -> None:
         # mirror 1 s, then away: the timer starts with the away part and fires 3 s into it
         (((1.0, ROAD_POSE), (1.0, LEFT_MIRROR), (5.0, AWAY_POSE)), 1.0 + 1.0 + 3.0),
         # away 2 s, mirror 2 s (pauses, does not reset), away again: 1 s more
-        (((1.0, ROAD_POSE), (2.0, AWAY_POSE), (2.0, RIGHT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 5.0),
+        (((1.0, ROAD_POSE), (2.0, AWAY_POSE), (2.0, LEFT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 5.0),
         # mirror 1.5 s then away 2 s: 2 s of distraction, no alert
         (((1.0, ROAD_POSE), (1.5, LEFT_MIRROR), (2.0, AWAY_POSE), (2.0, ROAD_POSE)), None),
         # the lap is not driving-related

@@ -13,7 +13,8 @@ DEFAULTS = MonitorConfig().zone_map()
 def test_the_configured_defaults_are_the_documented_table() -> None:
     assert DEFAULTS.zones == DEFAULT_ZONES
     assert DEFAULTS.names == (
-        "road", "lap", "cluster", "centre_stack", "left_mirror", "right_mirror", "away",
+        "road", "lap", "cluster", "centre_stack", "left_mirror", "right_mirror",
+        "far_left", "far_right", "roof", "away",
     )  # fmt: skip
     assert DEFAULTS.driving_related == frozenset({"left_mirror", "right_mirror"})
 
@@ -29,10 +30,10 @@ def test_the_configured_defaults_are_the_documented_table() -> None:
         (-30.0, -20.0, "centre_stack"),
         (-20.0, -30.0, "lap"),  # lap is tested before the centre stack
         (45.0, 0.0, "left_mirror"),
-        (-60.0, -10.0, "right_mirror"),
-        (-30.0, 0.0, "away"),  # passenger / rear-view mirror: not a configured zone
-        (0.0, 30.0, "away"),  # looking up
-        (90.0, 0.0, "away"),
+        (-45.0, 0.0, "right_mirror"),
+        (-27.0, 0.0, "away"),  # rear-view mirror: not a configured zone
+        (0.0, 18.0, "away"),  # looking up, below the roof
+        (52.0, 0.0, "away"),  # past the left mirror, short of 55 deg
     ],
 )
 def test_first_match_wins_else_away(yaw_deg: float, pitch_deg: float, zone: str) -> None:
@@ -53,8 +54,10 @@ def test_first_match_wins_else_away(yaw_deg: float, pitch_deg: float, zone: str)
         ("lap", 0.0, -12.0, "cluster"),
         ("cluster", 0.0, -20.0, "cluster"),
         ("away", -22.0, 0.0, "away"),  # away is not sticky, but nothing else matches
-        ("right_mirror", -36.0, 0.0, "right_mirror"),
-        ("right_mirror", -34.0, 0.0, "away"),
+        ("right_mirror", -26.0, 0.0, "right_mirror"),
+        ("right_mirror", -24.0, 0.0, "away"),
+        ("left_mirror", 54.0, 0.0, "left_mirror"),
+        ("left_mirror", 56.0, 0.0, "far_left"),  # ADDW's area 1 beats hysteresis
     ],
 )
 def test_hysteresis_keeps_the_previous_zone(

@@ -123,7 +123,7 @@ def test_angles_are_relative_to_the_neutral_and_wrapped() -> None:
 
 def test_levels_follow_their_closed_forms() -> None:
     records = drive(
-        [(2.0, 5.0, eyes_of()), (2.0, 5.0, eyes_of(openness=0.05)), (2.0, -25.0, eyes_of())]
+        [(2.0, 5.0, eyes_of()), (2.0, 5.0, eyes_of(openness=0.05)), (2.0, -22.0, eyes_of())]
     )
     on_road = vss_values(records[round(1.9 * FPS)], CONFIG)
     assert on_road["Vehicle.Driver.IsEyesOnRoad"] is True
@@ -143,11 +143,12 @@ def test_levels_follow_their_closed_forms() -> None:
         100.0 - values["Vehicle.Driver.FatigueLevel"]
     )
     assert vss_values(records[round(3.5 * FPS)], CONFIG)["Vehicle.ADAS.DMS.IsWarning"] is True
-    # 1.5 s into a head glance 30 deg right of neutral (zone away): distraction 50 %.
+    # 1.5 s into a head glance 27 deg right of neutral (zone away; 30 is now the right mirror's
+    # edge): distraction 50 %.
     glance = vss_values(records[round(5.5 * FPS)], CONFIG)
     assert glance["Vehicle.Driver.DistractionLevel"] == pytest.approx(50.0, abs=100 / FPS)
     assert glance["Vehicle.Driver.IsEyesOnRoad"] is False
-    assert glance["Vehicle.Occupant.Row1.DriverSide.HeadPosition.Yaw"] == -30.0
+    assert glance["Vehicle.Occupant.Row1.DriverSide.HeadPosition.Yaw"] == -27.0
 
 
 def test_unknown_is_not_on_the_road_and_degraded_is_an_error() -> None:

@@ -5,6 +5,7 @@ from types import ModuleType
 from roadgaze.commands import (
     batch,
     bench,
+    conformance,
     data,
     demo,
     doctor,
@@ -31,6 +32,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     router,
     replay,
     batch,
+    conformance,
     recover,
     bench,
     evaluate,

@@ -15,7 +15,6 @@ from roadgaze.config.settings import (
     MonitorConfig,
     PoseConfig,
     SmoothingConfig,
-    ZoneConfig,
     load_config,
     parse_overrides,
 )
@@ -25,6 +24,7 @@ from roadgaze.config.zenoh import (
     ZenohConfig,
     check_key_template,
 )
+from roadgaze.config.zones import ZoneConfig
 
 __all__ = [
     "ENV_PREFIX",

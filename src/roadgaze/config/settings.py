@@ -18,9 +18,11 @@ from typing import TYPE_CHECKING, Any, Literal, Self
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
+from roadgaze.config.protocol import ProtocolSettings
 from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section as _Section
 from roadgaze.config.zenoh import ZenohConfig
+from roadgaze.config.zones import ZoneConfig, check_area1, default_zones, mirrored_zones
 from roadgaze.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -159,34 +161,7 @@ class SmoothingConfig(_Section):
         return self
 
 
-class ZoneConfig(_Section):
-    """One glance zone: a rectangle in yaw and pitch relative to the neutral pose, degrees."""
-
-    name: str = Field(pattern=r"^[a-z][a-z0-9_]{0,31}$")
-    yaw_deg: tuple[float, float]
-    """[min, max], > 0 = the driver's own left."""
-    pitch_deg: tuple[float, float]
-    """[min, max], > 0 = up."""
-
-    @field_validator("yaw_deg", "pitch_deg")
-    @classmethod
-    def _ordered(cls, value: tuple[float, float]) -> tuple[float, float]:
-        if not value[0] <= value[1]:
-            raise ValueError(f"needs [min, max] with min <= max, found {list(value)}")
-        return value
-
-
-def _default_zones() -> list[ZoneConfig]:
-    return [
-        ZoneConfig(name="lap", yaw_deg=(-25.0, 25.0), pitch_deg=(-90.0, -18.0)),
-        ZoneConfig(name="cluster", yaw_deg=(-15.0, 15.0), pitch_deg=(-18.0, -10.0)),
-        ZoneConfig(name="centre_stack", yaw_deg=(-55.0, -15.0), pitch_deg=(-50.0, -5.0)),
-        ZoneConfig(name="left_mirror", yaw_deg=(20.0, 75.0), pitch_deg=(-25.0, 15.0)),
-        ZoneConfig(name="right_mirror", yaw_deg=(-85.0, -40.0), pitch_deg=(-25.0, 15.0)),
-    ]
-
-
-class MonitorConfig(EyeMonitorSettings):
+class MonitorConfig(EyeMonitorSettings, ProtocolSettings):
     """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)
@@ -197,7 +172,7 @@ class MonitorConfig(EyeMonitorSettings):
     road_pitch_deg: tuple[float, float] = (-10.0, 15.0)
     """Pitch relative to the neutral within which the road zone is entered (left beyond the
     limits grown by `hysteresis_deg`)."""
-    zones: list[ZoneConfig] = Field(default_factory=_default_zones, max_length=32)
+    zones: list[ZoneConfig] = Field(default_factory=default_zones, max_length=32)
     """The other zones, in priority order after the road (first match wins; nothing: away)."""
     driving_related_zones: list[str] = Field(
         default_factory=lambda: ["left_mirror", "right_mirror"]
@@ -253,7 +228,15 @@ class MonitorConfig(EyeMonitorSettings):
                 f"driving_related_zones names zones that are not configured: {unknown} "
                 f"(zones: {names})"
             )
+        check_area1(self)
         return self
+
+    def effective_zones(self) -> list[ZoneConfig]:
+        """The zones in force: as configured, but the (left-hand-drive) defaults mirrored for a
+        right-hand-drive cabin."""
+        if self.cabin == "rhd" and self.zones == default_zones():
+            return mirrored_zones(self.zones)
+        return self.zones
 
     def zone_map(self) -> ZoneMap:
         """The zones as the monitor classifies with them, the road first."""
@@ -261,11 +244,13 @@ class MonitorConfig(EyeMonitorSettings):
 
         road_yaw = self.road_half_width_deg - self.hysteresis_deg
         road = Zone(ROAD, -road_yaw, road_yaw, *self.road_pitch_deg)
-        others = tuple(Zone(z.name, *z.yaw_deg, *z.pitch_deg) for z in self.zones)
+        others = tuple(Zone(z.name, *z.yaw_deg, *z.pitch_deg) for z in self.effective_zones())
         return ZoneMap(
             zones=(road, *others),
             hysteresis_deg=self.hysteresis_deg,
             driving_related=frozenset(self.driving_related_zones),
+            distraction_yaw_deg=self.distraction_yaw_deg,
+            roof_pitch_deg=self.roof_pitch_deg,
         )
 
     @model_validator(mode="after")

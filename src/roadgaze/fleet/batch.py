@@ -54,6 +54,8 @@ class BatchOptions:
     content_hash: bool = False
     retries: int = 2
     progress: bool = True
+    speed_kmh: float | None = None
+    """One vehicle speed (km/h) for every drive instead of their speed tracks."""
 
 
 @contextmanager
@@ -163,7 +165,11 @@ def run_batch(drives: Sequence[Drive], config: Config, options: BatchOptions) ->
             config = pinned_model(config)
         tasks = [
             DriveTask(
-                drive=drive, out_dir=out_dir, config=config, content_hash=options.content_hash
+                drive=drive,
+                out_dir=out_dir,
+                config=config,
+                content_hash=options.content_hash,
+                speed_kmh=options.speed_kmh,
             )
             for drive in drives
         ]

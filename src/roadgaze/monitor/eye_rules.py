@@ -6,6 +6,7 @@ Definitions and the evidence for each threshold: docs/monitor.md ("Eyes").
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.zones import Zone, ZoneMap
@@ -106,8 +107,4 @@ def eye_zone_map(zones: ZoneMap, margin_deg: float) -> ZoneMap:
     yaw_mid = 0.5 * (road.yaw_max_deg + road.yaw_min_deg)
     pitch_min = min(road.pitch_min_deg + margin_deg, road.pitch_max_deg)
     narrow = Zone(road.name, yaw_mid - yaw_half, yaw_mid + yaw_half, pitch_min, road.pitch_max_deg)
-    return ZoneMap(
-        zones=(narrow, *zones.zones[1:]),
-        hysteresis_deg=zones.hysteresis_deg,
-        driving_related=zones.driving_related,
-    )
+    return replace(zones, zones=(narrow, *zones.zones[1:]))

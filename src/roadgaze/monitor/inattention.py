@@ -19,26 +19,33 @@ Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monit
   driver is taken as still turned away, i.e. off road (zone: the last zone, `away` if that was
   driving-related); otherwise where they look is unknown (zone None) and, after
   `unavailable_s`, the driver is `driver_unavailable`.
-- `long_distraction`: the current off-road episode has spent `long_distraction_s` outside the
-  driving-related zones (`driving_related_zones`, the mirrors: their time pauses the timer, up to
-  `driving_glance_max_s` per continuous stay when that is set); level warning, raised to
-  critical at `critical_distraction_s`.
-- `vats`: off-road time (every zone but road) within the last `vats_window_s` reaches
-  `vats_threshold_s`; fires once and is re-armed after `vats_rearm_s` continuously on road.
+- frames: the sample's yaw and pitch are mapped from the camera's frame into the driver's
+  (`camera_mounting`, `cabin`: roadgaze.pose.mounting) before anything else.
+- `long_distraction`: the current off-road episode has spent the protocol's distraction time
+  (`roadgaze.monitor.protocols`: the earliest of the configured protocols' at this speed) outside
+  the driving-related zones (`driving_related_zones`, the mirrors: their time pauses the timer, up
+  to `driving_glance_max_s` per continuous stay when that is set; ADDW's area 1 never is); level
+  warning, raised to critical `critical_after_warning_s` later (not before
+  `critical_distraction_s`).
+- `temporary_failure` (roadgaze.monitor.failures): blocked, black, saturated or frozen frames,
+  no judgeable face, unjudgeable eyes, each for its time while moving; cleared once recovered.
+- `vats` (Euro NCAP only): off-road time (every zone but road) within the last `vats_window_s`
+  reaches `vats_threshold_s`; fires once and is re-armed after `vats_rearm_s` continuously on
+  road.
 - eyes (`roadgaze.monitor.eyes`): open, closed or unavailable per sample; with the eyes open and
   giving a direction the zone is judged on the gaze (head + eyes beyond `gaze_deadband_deg`)
   against a road `eyes_road_margin_deg` narrower, so an eyes-only glance counts; otherwise
   (eyes closed or unavailable) on the head pose. Closures raise `microsleep`, `sleep` and
   `unresponsive`; PERCLOS and long blinks `drowsy`; eyes unavailable `degraded`.
-- `unresponsive` on the distraction path: away (outside the road and driving-related zones)
-  `unresponsive_away_s`, or not back on the road `unresponsive_after_warning_s` after a
-  `long_distraction` or `vats` warning.
-- `cleared`: the first on-road sample with a face and eyes not closed after any distraction
-  alert; a closure's alerts once the eyes are open on the road again; `drowsy` once re-armed;
-  `degraded` once the eyes are back.
-- speed gating: time off road or unavailable counts only while the vehicle moves faster than
-  `min_speed_kmh` (`speed_kmh` None means unknown and is taken as moving), so no alert fires
-  below that speed.
+- `unresponsive` on the distraction path (Euro NCAP only): away (outside the road and
+  driving-related zones) `unresponsive_away_s`, or not back on the road
+  `unresponsive_after_warning_s` after a `long_distraction` or `vats` warning.
+- `cleared`: on the road with a face and eyes not closed for `clear_on_road_s` after any
+  distraction alert; a closure's alerts once the eyes are open on the road again; `drowsy` once
+  re-armed; `degraded` once the eyes are back.
+- speed gating: time off road or unavailable counts only while a configured protocol is active
+  (ADDW above `addw_min_speed_kmh`, Euro NCAP above `min_speed_kmh`; `speed_kmh` None means
+  unknown and is taken as moving, in the highest band), so no alert fires below that speed.
 
 Time accounting is sample-based: an off-road episode starts at the first off-road sample and its
 duration at a later sample is the difference of their timestamps, so each alert fires on the
@@ -48,13 +55,15 @@ first sample at or after its threshold, i.e. within one frame period of its defi
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.escalation import split_cleared, unresponsive_check
-from roadgaze.monitor.eye_rules import eye_zone_map
 from roadgaze.monitor.eyes import step_eyes
+from roadgaze.monitor.failures import frame_issue, step_failures
+from roadgaze.monitor.look import classify, finite, to_driver_frame
 from roadgaze.monitor.neutral import learn_neutral
+from roadgaze.monitor.protocols import Rule, distraction_trigger, moving_at, rule_of, uses
 from roadgaze.monitor.state import (
     EPS_S,
     MonitorState,
@@ -63,105 +72,19 @@ from roadgaze.monitor.state import (
     segment_distraction_s,
     window_total,
 )
-from roadgaze.monitor.zones import AWAY, ROAD, ZoneMap
+from roadgaze.monitor.zones import ROAD, ZoneMap
+from roadgaze.pose.mounting import CameraMounting, gaze_to_camera
 from roadgaze.types import (
     Alert,
     AlertKind,
     AlertLevel,
     EyeStatus,
-    EyesVerdict,
     Gaze,
     PoseSample,
     Verdict,
 )
 
 __all__ = ["Monitor", "MonitorState", "initial_state", "step", "verdict_of"]
-
-
-def _finite(smoothed: float | None, raw: float | None) -> float | None:
-    value = smoothed if smoothed is not None else raw
-    if value is None or not math.isfinite(value):
-        return None
-    return value
-
-
-@dataclass(frozen=True, slots=True)
-class _Look:
-    """Where the driver looks at one sample, as `_classify` judged it."""
-
-    gaze: Gaze
-    zone: str | None
-    face_zone: str
-    yaw_deg: float | None
-    pitch_deg: float | None
-    lost_since_s: float | None
-    turned_away: bool
-    by_eyes: bool = False
-
-    @property
-    def why(self) -> str:
-        """Why the driver counts as off road, for the alert's `reason`."""
-        if self.turned_away:
-            return f"face out of view, last seen in {self.zone}"
-        return f"{'eyes' if self.by_eyes else 'head'} in {self.zone}"
-
-
-def _eyes_moved(eyes: EyesVerdict, head_yaw_deg: float, head_pitch_deg: float) -> bool:
-    """The eyes give the gaze and have moved beyond the deadband (gaze != head pose)."""
-    return (
-        eyes.gaze_source == "eyes"
-        and eyes.gaze_yaw_deg is not None
-        and eyes.gaze_pitch_deg is not None
-        and (eyes.gaze_yaw_deg != head_yaw_deg or eyes.gaze_pitch_deg != head_pitch_deg)
-    )
-
-
-def _classify(
-    config: MonitorConfig,
-    zones: ZoneMap,
-    state: MonitorState,
-    sample: PoseSample,
-    t_s: float,
-    eyes: EyesVerdict,
-) -> _Look:
-    yaw = _finite(sample.yaw_deg, sample.yaw_raw_deg) if sample.face else None
-    pitch = _finite(sample.pitch_deg, sample.pitch_raw_deg) if sample.face else None
-    if sample.face:
-        if yaw is None:  # a face whose yaw the model cannot explain: keep the last decision
-            zone = state.face_zone
-        else:
-            pitch_offset = 0.0 if pitch is None else pitch - state.neutral_pitch_deg
-            zone = zones.classify(yaw - state.neutral_yaw_deg, pitch_offset, state.face_zone)
-            if _eyes_moved(eyes, yaw, state.neutral_pitch_deg if pitch is None else pitch):
-                # An eye glance: judged on the gaze, on a narrower road. The eyes may take the
-                # gaze off a road the head is on, never back onto it: a head judged off road
-                # stays off road (fail-safe; MediaPipe's eye direction is least reliable with
-                # the head turned, where it can read the eyes turned back by 15-20 deg).
-                gaze_zones = eye_zone_map(zones, config.eyes_road_margin_deg)
-                gaze_zone = gaze_zones.classify(
-                    (eyes.gaze_yaw_deg or 0.0) - state.neutral_yaw_deg,
-                    (eyes.gaze_pitch_deg or 0.0) - state.neutral_pitch_deg,
-                    state.face_zone,
-                )
-                if gaze_zone != ROAD or zone == ROAD:
-                    gaze = Gaze.ON_ROAD if gaze_zone == ROAD else Gaze.OFF_ROAD
-                    return _Look(gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, by_eyes=True)
-        gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
-        return _Look(gaze, zone, zone, yaw, pitch, None, False)
-    if state.face_lost_since_s is not None:
-        lost_since, turned = state.face_lost_since_s, state.face_lost_turned_away
-    else:
-        lost_since = t_s
-        if config.turn_away_deg is None or state.last_face_yaw_deg is None:
-            turned = not state.on_road
-        else:
-            turned = abs(state.last_face_yaw_deg - state.neutral_yaw_deg) > config.turn_away_deg
-    if not turned:
-        return _Look(Gaze.UNKNOWN, None, state.face_zone, None, None, lost_since, False)
-    zone = state.face_zone
-    if zone == ROAD or zones.is_driving_related(zone):  # out of view: no longer a mirror glance
-        zone = AWAY
-    return _Look(Gaze.OFF_ROAD, zone, zone, None, None, lost_since, True)
 
 
 def _count(counts: tuple[tuple[str, int], ...], alerts: list[Alert]) -> tuple[tuple[str, int], ...]:
@@ -180,31 +103,42 @@ def step(
     sample: PoseSample,
     speed_kmh: float | None,
     zones: ZoneMap | None = None,
+    mounting: CameraMounting | None = None,
 ) -> tuple[MonitorState, tuple[Alert, ...]]:
     """Advance the monitor by one sample; returns the new state and the alerts it raised.
 
     `speed_kmh` None means no speed is known and the vehicle is taken as moving. A sample whose
     `t_s` is not after the previous one is ignored (the state is returned unchanged). `zones`
-    defaults to `config.zone_map()` (pass it to avoid rebuilding it every sample).
+    defaults to `config.zone_map()` and `mounting` to `config.mounting()` (pass them to avoid
+    rebuilding them every sample). The sample's angles are in the camera's frame; they are
+    mapped into the driver's frame first.
     """
     t_s = sample.t_s
     if not math.isfinite(t_s) or (state.t_s is not None and t_s <= state.t_s):
         return state, ()
     zones = zones if zones is not None else config.zone_map()
-    moving = speed_kmh is None or speed_kmh > config.min_speed_kmh
-    head_pitch = _finite(sample.pitch_deg, sample.pitch_raw_deg)
+    sample = to_driver_frame(mounting if mounting is not None else config.mounting(), sample)
+    moving = moving_at(config, speed_kmh)
+    head_pitch = finite(sample.pitch_deg, sample.pitch_raw_deg)
     eyes, eye_events = step_eyes(
         config,
         state.eyes,
         sample,
         moving,
         state.on_road,
-        _finite(sample.yaw_deg, sample.yaw_raw_deg) if sample.face else None,
+        finite(sample.yaw_deg, sample.yaw_raw_deg) if sample.face else None,
         state.neutral_pitch_deg if head_pitch is None else head_pitch,
     )
-    look = _classify(config, zones, state, sample, t_s, eyes.verdict)
+    look = classify(config, zones, state, sample, t_s, eyes.verdict)
     gaze, yaw = look.gaze, look.yaw_deg
     alerts: list[Alert] = []
+    # The protocols' distraction warning at this speed (ADDW's allowance when the service knows
+    # conditions are non-nominal: eyes hidden, or a poor frame).
+    non_nominal = eyes.verdict.reason == "eyes hidden" or bool(
+        frame_issue(config, sample.frame_check)
+    )
+    trigger = distraction_trigger(config, speed_kmh, non_nominal) if moving else None
+    ncap = uses(config, "euroncap")
 
     # Continuous off-road episode, its distraction time and the VATS window (while moving).
     counted_off = gaze is Gaze.OFF_ROAD and moving
@@ -248,8 +182,13 @@ def step(
     unavailable_s = 0.0 if unavailable_since is None else t_s - unavailable_since
 
     def alert(
-        kind: AlertKind, level: AlertLevel, clears: tuple[AlertKind, ...] = (), reason: str = ""
+        kind: AlertKind,
+        level: AlertLevel,
+        clears: tuple[AlertKind, ...] = (),
+        reason: str = "",
+        rule: Rule | None = None,
     ) -> Alert:
+        rule = rule if rule is not None else rule_of(kind, level, reason)
         return Alert(
             kind=kind,
             level=level,
@@ -263,18 +202,27 @@ def step(
             closure_s=eyes.closure_s(),
             perclos=eyes.verdict.perclos,
             reason=reason,
+            rule="" if rule is None else rule.key,
+            source="" if rule is None else rule.source,
         )
 
     active = list(state.active)
-    if counted_off:
-        if (
-            distraction_now_s >= config.critical_distraction_s - EPS_S
-            and long_level is not AlertLevel.CRITICAL
-        ):
+    if counted_off and trigger is not None:
+        critical_s = max(
+            config.critical_distraction_s, trigger.warn_s + config.critical_after_warning_s
+        )
+        if distraction_now_s >= critical_s - EPS_S and long_level is not AlertLevel.CRITICAL:
             alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.CRITICAL, reason=look.why))
             long_level = AlertLevel.CRITICAL
-        elif distraction_now_s >= config.long_distraction_s - EPS_S and long_level is None:
-            alerts.append(alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING, reason=look.why))
+        elif distraction_now_s >= trigger.warn_s - EPS_S and long_level is None:
+            alerts.append(
+                alert(
+                    AlertKind.LONG_DISTRACTION,
+                    AlertLevel.WARNING,
+                    reason=look.why,
+                    rule=trigger.rule,
+                )
+            )
             long_level = AlertLevel.WARNING
 
     vats_armed = state.vats_armed
@@ -291,7 +239,7 @@ def step(
     # sample that ends it, i.e. when the driver looks back; it is cleared at the next one.
     just_ended = state.off_since_s is not None and off_since is None
     vats_due = counted_off or (just_ended and moving)
-    if vats_due and vats_armed and window_s >= config.vats_threshold_s - EPS_S:
+    if ncap and vats_due and vats_armed and window_s >= config.vats_threshold_s - EPS_S:
         alerts.append(alert(AlertKind.VATS, AlertLevel.WARNING))
         vats_armed = False
 
@@ -303,11 +251,23 @@ def step(
         alerts.append(alert(kind, level, reason=reason))
     away_unresponsive = state.away_unresponsive and off_since is not None
     warned_since, away_unresponsive, unresponsive = unresponsive_check(
-        config, state, alerts, t_s, moving, looking, distraction_now_s, away_unresponsive
+        config, state, alerts, t_s, moving and ncap, looking, distraction_now_s, away_unresponsive
     )
     if unresponsive:
         alerts.append(alert(AlertKind.UNRESPONSIVE, AlertLevel.CRITICAL, reason=unresponsive))
-    cleared, active = split_cleared(active, eyes, looking)
+    failures, failure_events, failure_ended = step_failures(
+        config, state.failures, sample, moving, ncap and eyes.degraded
+    )
+    for kind, level, reason in failure_events:
+        alerts.append(alert(kind, level, reason=reason))
+    # Cleared once looking at the road for `clear_on_road_s` (0: at once).
+    looked_s = 0.0 if on_since is None else t_s - on_since
+    cleared, active = split_cleared(
+        active, eyes, looking and looked_s >= config.clear_on_road_s - EPS_S
+    )
+    if failure_ended and AlertKind.TEMPORARY_FAILURE in active:
+        cleared = (*cleared, AlertKind.TEMPORARY_FAILURE)
+        active.remove(AlertKind.TEMPORARY_FAILURE)
     if cleared:
         alerts.append(alert(AlertKind.CLEARED, AlertLevel.INFO, clears=cleared))
     for raised in alerts:
@@ -351,6 +311,9 @@ def step(
         eyes=eyes,
         warned_since_s=warned_since,
         away_unresponsive=away_unresponsive,
+        failures=failures,
+        warn_s=None if trigger is None else trigger.warn_s,
+        warn_rule="" if trigger is None else trigger.rule.key,
     )
     return new_state, tuple(alerts)
 
@@ -375,7 +338,18 @@ def verdict_of(config: MonitorConfig, state: MonitorState) -> Verdict:
         pitch_deg=state.pitch_deg,
         neutral_pitch_deg=state.neutral_pitch_deg,
         distraction_s=distraction_s(config, state),
+        failure=state.failures.reason,
+        distraction_warn_s=state.warn_s,
+        distraction_rule=state.warn_rule,
+        camera_neutral_deg=_camera_neutral(config, state),
     )
+
+
+def _camera_neutral(config: MonitorConfig, state: MonitorState) -> tuple[float, float] | None:
+    mounting = config.mounting()
+    if mounting.is_identity:
+        return None
+    return gaze_to_camera(mounting, state.neutral_yaw_deg, state.neutral_pitch_deg)
 
 
 class Monitor:
@@ -384,12 +358,22 @@ class Monitor:
     def __init__(self, config: MonitorConfig, state: MonitorState | None = None) -> None:
         self.config = config
         self.zones = config.zone_map()
+        self.mounting = config.mounting()
         self.state = initial_state(config) if state is None else state
 
     def update(self, sample: PoseSample, speed_kmh: float | None = None) -> tuple[Alert, ...]:
         """Advance by one sample; returns the alerts it raised (the verdict is `verdict`)."""
-        self.state, alerts = step(self.config, self.state, sample, speed_kmh, self.zones)
+        self.state, alerts = step(
+            self.config, self.state, sample, speed_kmh, self.zones, self.mounting
+        )
         return alerts
+
+    @property
+    def camera_neutral_pitch_deg(self) -> float:
+        """The learned road-ahead pitch as the camera sees it (the pose stage's down gain starts
+        there); the neutral itself is in the driver's frame."""
+        camera = _camera_neutral(self.config, self.state)
+        return self.state.neutral_pitch_deg if camera is None else camera[1]
 
     @property
     def verdict(self) -> Verdict:

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.eyes import EyeMonitorState
+from roadgaze.monitor.failures import FailureState
 from roadgaze.monitor.zones import ROAD
 from roadgaze.types import AlertKind, AlertLevel, Gaze
 
@@ -74,6 +75,12 @@ class MonitorState:
     """When a distraction warning asked the driver to look back and they have not yet."""
     away_unresponsive: bool = False
     """`unresponsive` was raised for the current off-road episode."""
+    failures: FailureState = field(default_factory=FailureState)
+    """The failure timers (roadgaze.monitor.failures)."""
+    warn_s: float | None = None
+    """The distraction time that warns at the last sample's speed; None when none is active."""
+    warn_rule: str = ""
+    """The rule giving `warn_s`."""
 
     @property
     def on_road(self) -> bool:

@@ -11,6 +11,11 @@ neutral (road-ahead) pose, yaw > 0 = the driver's own left, pitch > 0 = up; the 
 3. Otherwise the rectangles are tested in order, first match wins (edges included).
 4. Nothing matched: `away`.
 
+Before all of these, ADDW's distraction area 1 (EU 2023/2590 Annex I): a sample beyond
++-`distraction_yaw_deg` (55) of yaw is `far_left` / `far_right`, one above `roof_pitch_deg` is
+`roof`, whatever the previous zone or the configured rectangles; they are never driving-related
+(the configuration refuses it).
+
 The rectangles are the limits for *entering* a zone: with the defaults the road is entered within
 +-20 deg yaw and left beyond +-25 deg (`road_half_width_deg` 25, `hysteresis_deg` 5). The
 classifier is a pure function of the two angles, so any source of angles (head pose today, eye
@@ -23,7 +28,10 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from roadgaze.config.protocol import AREA1_ZONE_NAMES
+
 __all__ = [
+    "AREA1_ZONES",
     "AWAY",
     "DEFAULT_DRIVING_RELATED",
     "DEFAULT_ZONES",
@@ -35,6 +43,9 @@ __all__ = [
 
 ROAD = "road"
 AWAY = "away"
+FAR_LEFT, FAR_RIGHT, ROOF = AREA1_ZONE_NAMES
+AREA1_ZONES = AREA1_ZONE_NAMES
+"""ADDW's distraction area 1: beyond the +-55 deg planes (the driver's left, right) and the roof."""
 DEFAULT_DRIVING_RELATED = ("left_mirror", "right_mirror")
 """Zones whose glances belong to the driving task: off road (for VATS and `eyes_on_road`), but
 they do not run the long-distraction timer (docs/monitor.md)."""
@@ -64,11 +75,26 @@ DEFAULT_ZONES: tuple[Zone, ...] = (
     Zone("lap", -25.0, 25.0, -90.0, -18.0),
     Zone("cluster", -15.0, 15.0, -18.0, -10.0),
     Zone("centre_stack", -55.0, -15.0, -50.0, -5.0),
-    Zone("left_mirror", 20.0, 75.0, -25.0, 15.0),
-    Zone("right_mirror", -85.0, -40.0, -25.0, 15.0),
+    Zone("left_mirror", 20.0, 50.0, -25.0, 10.0),
+    Zone("right_mirror", -55.0, -30.0, -25.0, 10.0),
 )
 """In priority order; each number's source is in docs/monitor.md."""
 DEFAULT_HYSTERESIS_DEG = 5.0
+DEFAULT_DISTRACTION_YAW_DEG = 55.0
+DEFAULT_ROOF_PITCH_DEG = 20.0
+
+
+def area1_zone(
+    yaw_deg: float, pitch_deg: float, yaw_limit_deg: float, roof_deg: float
+) -> str | None:
+    """ADDW's distraction area 1 for these angles (relative to the neutral), or None."""
+    if yaw_deg > yaw_limit_deg:
+        return FAR_LEFT
+    if yaw_deg < -yaw_limit_deg:
+        return FAR_RIGHT
+    if pitch_deg > roof_deg:
+        return ROOF
+    return None
 
 
 def classify_zone(
@@ -103,9 +129,15 @@ class ZoneMap:
     zones: tuple[Zone, ...] = DEFAULT_ZONES
     hysteresis_deg: float = DEFAULT_HYSTERESIS_DEG
     driving_related: frozenset[str] = frozenset(DEFAULT_DRIVING_RELATED)
+    distraction_yaw_deg: float = DEFAULT_DISTRACTION_YAW_DEG
+    """ADDW area 1: beyond +-this yaw is always `far_left` / `far_right`."""
+    roof_pitch_deg: float = DEFAULT_ROOF_PITCH_DEG
+    """ADDW area 1: above this pitch is always `roof`."""
 
     def __post_init__(self) -> None:
         names = [zone.name for zone in self.zones]
+        if set(AREA1_ZONES) & set(names):
+            raise ValueError(f"zone names {list(AREA1_ZONES)} are reserved, found {names}")
         if not names or names[0] != ROAD:
             raise ValueError(f"the first zone must be '{ROAD}', found {names[:1]}")
         if AWAY in names or len(set(names)) != len(names):
@@ -119,11 +151,14 @@ class ZoneMap:
 
     @property
     def names(self) -> tuple[str, ...]:
-        """Every zone a sample can be given: the configured ones, then `away`."""
-        return (*(zone.name for zone in self.zones), AWAY)
+        """Every zone a sample can be given: the configured ones, then area 1's, then `away`."""
+        return (*(zone.name for zone in self.zones), *AREA1_ZONES, AWAY)
 
     def classify(self, yaw_deg: float, pitch_deg: float, previous_zone: str | None) -> str:
-        """`classify_zone` with this map's zones and hysteresis."""
+        """ADDW's area 1 first, else `classify_zone` with this map's zones and hysteresis."""
+        area = area1_zone(yaw_deg, pitch_deg, self.distraction_yaw_deg, self.roof_pitch_deg)
+        if area is not None:
+            return area
         return classify_zone(yaw_deg, pitch_deg, previous_zone, self.zones, self.hysteresis_deg)
 
     def is_driving_related(self, zone: str | None) -> bool:

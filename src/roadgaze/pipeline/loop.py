@@ -18,12 +18,17 @@ from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
+import numpy as np
+import numpy.typing as npt
+
 from roadgaze.capture import FrameSource
 from roadgaze.config import Config, EyesConfig
 from roadgaze.landmarks.eyes import driver_eyes
 from roadgaze.monitor import Monitor
+from roadgaze.monitor.failures import check_frame
 from roadgaze.pipeline.handoff import Handoff
 from roadgaze.pipeline.runtime import Collector, loop_runtime
+from roadgaze.pipeline.speed import SpeedSource, VehicleSpeed, no_speed, vehicle_speed
 from roadgaze.pipeline.steps import (
     Decoded,
     DetectorSteps,
@@ -45,14 +50,6 @@ INFER_AHEAD_FRAMES = 1
 STOP_GRACE_S = 1.0
 """After a stop is asked for, how long the frame in hand may take before a live source is closed
 (which unblocks a loop waiting for a lost camera)."""
-
-SpeedSource = Callable[[], float | None]
-"""The vehicle speed in km/h for the monitor; None when unknown (taken as moving)."""
-
-
-def no_speed() -> float | None:
-    """The speed source of a replay without a bus: always unknown, i.e. moving (fail-safe)."""
-    return None
 
 
 class StopSignal(Protocol):
@@ -87,7 +84,7 @@ class Pipeline:
         detector: LandmarkDetector,
         pose: PoseEstimator | None = None,
         monitor: Monitor | None = None,
-        speed: SpeedSource = no_speed,
+        speed: SpeedSource | VehicleSpeed = no_speed,
         clock: Callable[[], float] = time.perf_counter,
         eyes: EyesConfig | None = None,
     ) -> None:
@@ -95,14 +92,20 @@ class Pipeline:
         self.eyes = eyes if eyes is not None else EyesConfig()
         self.pose = pose if pose is not None else PoseEstimator()
         self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
-        self.speed = speed
+        self.speed = vehicle_speed(speed)
+        """The vehicle speed at each frame's time (a zero-argument source is the bus's)."""
         self._clock = clock
         self._steps = DetectorSteps.of(detector)
         self._frame_received_s = math.nan
+        self._previous_grey: npt.NDArray[np.float32] | None = None
+        """The last frame's grey sample, for the frozen-frame check."""
 
     @classmethod
     def from_config(
-        cls, config: Config, detector: LandmarkDetector, speed: SpeedSource = no_speed
+        cls,
+        config: Config,
+        detector: LandmarkDetector,
+        speed: SpeedSource | VehicleSpeed = no_speed,
     ) -> Pipeline:
         return cls(
             detector=detector,
@@ -133,13 +136,15 @@ class Pipeline:
         driver = detection.driver
         yaw_raw_deg = self.pose.raw_yaw_deg(driver)
         # The matrix pitch's down gain starts at the monitor's current neutral pitch.
-        pitch_raw_deg = self.pose.raw_pitch_deg(driver, self.monitor.state.neutral_pitch_deg)
+        pitch_raw_deg = self.pose.raw_pitch_deg(driver, self.monitor.camera_neutral_pitch_deg)
         eyes = driver_eyes(driver, yaw_raw_deg, self.eyes)
         after_geometry = clock()
         sample = self.pose.smooth(frame.t_s, frame.index, detection, yaw_raw_deg, pitch_raw_deg)
         sample = sample if eyes is None else replace(sample, eyes=eyes)
+        frame_check, self._previous_grey = check_frame(frame.image, self._previous_grey)
+        sample = replace(sample, frame_check=frame_check)
         after_smoothing = clock()
-        alerts = self.monitor.update(sample, self.speed())
+        alerts = self.monitor.update(sample, self.speed.kmh_at(frame.t_s))
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)
         after_monitor = clock()
         times = StageTimes(

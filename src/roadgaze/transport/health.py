@@ -64,6 +64,8 @@ class Health:
         self.recent_alerts: deque[Alert] = deque(maxlen=RECENT_ALERTS)
         self.last: FrameRecord | None = None
         self._initial_verdict = verdict_of(config.monitor, initial_state(config.monitor))
+        self.permanent_failure = ""
+        """The permanent failure in force ('' for none; roadgaze.transport.failure_watch)."""
         self.problem_checks: list[Callable[[], str | None]] = []
         """Other parts' problems (a recording that stopped), asked at each state message."""
 
@@ -74,21 +76,25 @@ class Health:
         if self.status == "starting":
             self.status = "running"
         for alert in record.alerts:
-            message = AlertMessage.from_alert(
-                alert, self.keys.vehicle_id, self.alerts_raised, self._wall_clock()
-            )
-            self.alerts_raised += 1
-            self.recent_alerts.append(alert)
-            self._log.info(
-                "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)%s",
-                alert.kind.value,
-                alert.level.value,
-                alert.t_s,
-                alert.off_road_s,
-                alert.window_off_road_s,
-                f": {alert.reason}" if alert.reason else "",
-                extra={"alert": message.model_dump(mode="json", by_alias=True)},
-            )
+            self.note_alert(alert)
+
+    def note_alert(self, alert: Alert) -> None:
+        """Count and log one alert (from a record, or raised outside the loop)."""
+        message = AlertMessage.from_alert(
+            alert, self.keys.vehicle_id, self.alerts_raised, self._wall_clock()
+        )
+        self.alerts_raised += 1
+        self.recent_alerts.append(alert)
+        self._log.info(
+            "alert %s %s at t=%.2fs (off road %.2fs, window %.2fs)%s",
+            alert.kind.value,
+            alert.level.value,
+            alert.t_s,
+            alert.off_road_s,
+            alert.window_off_road_s,
+            f": {alert.reason}" if alert.reason else "",
+            extra={"alert": message.model_dump(mode="json", by_alias=True)},
+        )
 
     def _speed(
         self,
@@ -125,6 +131,10 @@ class Health:
                 f"eyes unavailable for {eyes.unavailable_s:.0f} s ({eyes.reason or 'unknown'}): "
                 "monitoring on head pose only"
             )
+        if verdict.failure and not (eyes.degraded and verdict.failure == "eyes unjudgeable"):
+            problems.append(f"temporary failure: {verdict.failure}")  # (the eyes: said above)
+        if self.permanent_failure:
+            problems.append(f"permanent failure: {self.permanent_failure}")
         problems.extend(problem for check in self.problem_checks if (problem := check()))
         status = self.status
         if status in ("starting", "running") and problems:
@@ -142,6 +152,7 @@ class Health:
             frames=self.frames,
             faces=self.faces,
             camera_reopens=camera_reopens,
+            permanent_failure=self.permanent_failure,
             transport=transport,
             monitor=MonitorSnapshot(
                 **EyeFields.of(eyes),
@@ -162,6 +173,12 @@ class Health:
                 speed_source=speed_source,
                 alert_counts=dict(verdict.alert_counts),
                 eye_calibration=eyes.calibration,
+                protocol=monitor.protocol,
+                camera_mounting=monitor.mounting().name,
+                distraction_s=max(0.0, verdict.distraction_s),
+                distraction_warn_s=verdict.distraction_warn_s,
+                distraction_rule=verdict.distraction_rule,
+                failure=verdict.failure,
             ),
             config={
                 "monitor": monitor.model_dump(mode="json"),

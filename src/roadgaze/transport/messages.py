@@ -24,7 +24,7 @@ from roadgaze.types import (
 )
 
 YAW_SCHEMA = "roadgaze.yaw/3"
-ALERT_SCHEMA = "roadgaze.alert/2"
+ALERT_SCHEMA = "roadgaze.alert/3"
 STATE_SCHEMA = "roadgaze.state/4"
 
 
@@ -93,7 +93,10 @@ class YawMessage(EyeFields):
     `eyes_on_road` and `neutral_pitch_deg`; `roadgaze.yaw/3` adds the eye fields (`eyes`,
     `eye_openness`, `gaze_*`, `closure_s`, `perclos`, `blinks`, `eyes_unavailable_s`,
     `degraded`), and `eyes_on_road` is false while the eyes are closed. Every earlier field keeps
-    its name and meaning.
+    its name and meaning. `yaw_deg` and `pitch_deg` are the camera's measurement; with a camera
+    not in front (`[monitor] camera_mounting`) `neutral_yaw_deg` / `neutral_pitch_deg` are the
+    road-ahead pose as the camera sees it too, so `yaw_deg - neutral_yaw_deg` keeps its meaning
+    (the monitor judges in the driver's frame: the state message).
     """
 
     schema_id: Literal["roadgaze.yaw/3"] = Field(default="roadgaze.yaw/3", alias="schema")
@@ -123,7 +126,8 @@ class YawMessage(EyeFields):
     zone: str | None = Field(
         default=None,
         description="Glance zone: road, lap, cluster, centre_stack, left_mirror, right_mirror "
-        "(or another configured zone) or away; null when the gaze is unknown.",
+        "(or another configured zone), far_left / far_right / roof (ADDW's distraction area 1) "
+        "or away; null when the gaze is unknown.",
     )
     eyes_on_road: bool | None = Field(
         default=None,
@@ -137,6 +141,7 @@ class YawMessage(EyeFields):
     ) -> YawMessage:
         """The yaw message of one frame record."""
         sample, verdict = record.sample, record.verdict
+        neutral = verdict.camera_neutral_deg or (verdict.neutral_yaw_deg, verdict.neutral_pitch_deg)
         return cls(
             vehicle_id=vehicle_id,
             seq=seq,
@@ -149,14 +154,14 @@ class YawMessage(EyeFields):
             yaw_rate_dps=sample.yaw_rate_dps,
             on_road=verdict.on_road,
             gaze=verdict.gaze,
-            neutral_yaw_deg=verdict.neutral_yaw_deg,
+            neutral_yaw_deg=neutral[0],
             n_faces=sample.n_faces,
             pitch_deg=sample.pitch_deg,
             pitch_raw_deg=sample.pitch_raw_deg,
             roll_deg=sample.roll_deg,
             zone=verdict.zone,
             eyes_on_road=verdict.eyes_on_road,
-            neutral_pitch_deg=verdict.neutral_pitch_deg,
+            neutral_pitch_deg=neutral[1],
             **EyeFields.of(verdict.eyes),
         )
 
@@ -165,10 +170,13 @@ class AlertMessage(_Message):
     """One monitor event (see docs/monitor.md).
 
     `roadgaze.alert/2` adds the kinds `microsleep`, `sleep`, `drowsy`, `unresponsive` and
-    `degraded`, and the fields `closure_s`, `perclos` and `reason`.
+    `degraded`, and the fields `closure_s`, `perclos` and `reason`; `roadgaze.alert/3` adds the
+    kinds `temporary_failure` and `permanent_failure` (with the failure in `reason`) and the
+    fields `rule` and `source`: the protocol rule the alert fired by and where that rule comes
+    from (docs/monitor.md, "Protocols"). Every earlier field keeps its name and meaning.
     """
 
-    schema_id: Literal["roadgaze.alert/2"] = Field(default="roadgaze.alert/2", alias="schema")
+    schema_id: Literal["roadgaze.alert/3"] = Field(default="roadgaze.alert/3", alias="schema")
     vehicle_id: str
     seq: int = Field(ge=0)
     kind: AlertKind
@@ -186,6 +194,12 @@ class AlertMessage(_Message):
     closure_s: float = Field(default=0.0, ge=0, description="Current eye closure length.")
     perclos: float | None = Field(default=None, ge=0, le=1)
     reason: str = Field(default="", description="Why it fired, in a few words.")
+    rule: str = Field(
+        default="",
+        description="The protocol rule it fired by, e.g. 'addw.distraction.above_50kmh', "
+        "'euroncap.long_distraction' ('' for none).",
+    )
+    source: str = Field(default="", description="Where that rule comes from.")
 
     @classmethod
     def from_alert(cls, alert: Alert, vehicle_id: str, seq: int, wall_time: float) -> AlertMessage:
@@ -206,6 +220,8 @@ class AlertMessage(_Message):
             closure_s=max(0.0, alert.closure_s),
             perclos=alert.perclos,
             reason=alert.reason,
+            rule=alert.rule,
+            source=alert.source,
         )
 
 
@@ -287,6 +303,18 @@ class MonitorSnapshot(EyeFields):
     speed_kmh: float | None
     speed_source: Literal["none", "waiting", "fresh", "stale", "invalid"]
     alert_counts: dict[str, int]
+    protocol: Literal["addw", "euroncap", "both"] = "both"
+    camera_mounting: str = Field(
+        default="front", description="The camera mounting preset (or 'custom' angles)."
+    )
+    distraction_s: float = Field(default=0.0, ge=0, description="The long-distraction timer.")
+    distraction_warn_s: float | None = Field(
+        default=None, description="Distraction time that warns at this speed; null: inactive."
+    )
+    distraction_rule: str = Field(default="", description="The rule giving it.")
+    failure: str = Field(
+        default="", description="The temporary failure in force ('' for none), with its reason."
+    )
     eye_calibration: EyeCalibrationStatus = Field(
         default=EyeCalibrationStatus.NONE,
         description="none, learning or calibrated: the eyes move the gaze only once the "
@@ -301,9 +329,13 @@ class StateMessage(_Message):
     `roadgaze.state/3` adds link and delivery fields to `transport` (see `TransportStatus`, and
     `vss_sent`), the speed source `invalid`, the eye fields of the yaw message to `monitor`, and
     the status `degraded` (with a problem saying why) while the eyes have been unavailable too
-    long; `roadgaze.state/4` adds `eye_calibration` to `monitor`, and `alerts_waiting`,
-    `alerts_lost` and `undelivered_alerts` to `transport` (the alert ledger). Every earlier field
-    keeps its name and meaning.
+    long. `roadgaze.state/4` adds to `monitor` the protocol, the camera mounting, the
+    distraction timer and the time and rule that warn at the current speed, and the temporary
+    failure in force, and the eye calibration (`eye_calibration`); `permanent_failure` (the
+    camera gone past `permanent_failure_s`); and `alerts_waiting`, `alerts_lost` and
+    `undelivered_alerts` to `transport` (the alert ledger). The monitor's angles are in the
+    driver's frame (the camera mounting applied). Every earlier field keeps its name and
+    meaning.
     """
 
     schema_id: Literal["roadgaze.state/4"] = Field(default="roadgaze.state/4", alias="schema")
@@ -318,6 +350,9 @@ class StateMessage(_Message):
     frames: int
     faces: int
     camera_reopens: int = 0
+    permanent_failure: str = Field(
+        default="", description="The permanent failure in force ('' for none), with its reason."
+    )
     transport: TransportStatus
     monitor: MonitorSnapshot
     config: dict[str, Any]

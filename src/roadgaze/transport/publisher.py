@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
 from typing import Protocol
 
 from roadgaze.transport.messages import AlertMessage, TransportStatus, YawMessage
 from roadgaze.transport.speed import SpeedInput
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.types import Alert, Frame, FrameRecord
 
 
 class MessageLink(Protocol):
@@ -40,6 +41,7 @@ class BusPublisher:
         self._wall_clock = wall_clock
         self._yaw_seq = 0
         self._alert_seq = 0
+        self._lock = threading.Lock()
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         wall_time = self._wall_clock()
@@ -48,9 +50,16 @@ class BusPublisher:
         )
         self._yaw_seq += 1
         for alert in record.alerts:
+            self.publish_alert(alert, wall_time)
+
+    def publish_alert(self, alert: Alert, wall_time: float | None = None) -> None:
+        """Publish one alert with the next sequence number (also from outside the loop: the
+        permanent failure watch)."""
+        wall_time = self._wall_clock() if wall_time is None else wall_time
+        with self._lock:
             message = AlertMessage.from_alert(alert, self.vehicle_id, self._alert_seq, wall_time)
             self._alert_seq += 1
-            self.link.publish_alert(message)
+        self.link.publish_alert(message)
 
     def close(self) -> None:
         """Nothing to release: the link is owned by whoever opened it."""

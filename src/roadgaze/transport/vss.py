@@ -13,8 +13,10 @@ has the whole state within a second, and a silent key means a silent service.
 Values (definitions and how the levels are computed: docs/zenoh.md):
 
 - `IsEyesOnRoad`: on the road with the eyes not closed; false when unknown (fail-safe).
-- `DistractionLevel` = 100 min(1, max(distraction_s / long_distraction_s,
-  window_off_road_s / vats_threshold_s)): 100 % exactly when `long_distraction` or `vats` is due.
+- `DistractionLevel` = 100 min(1, max(distraction_s / warn_s, window_off_road_s /
+  vats_threshold_s)), warn_s the distraction time that warns at this speed under the configured
+  protocol(s) (`long_distraction_s` when none is active): 100 % exactly when `long_distraction`
+  or `vats` is due.
 - `FatigueLevel` = 100 min(1, max(PERCLOS / perclos_drowsy, long blinks / long_blinks_drowsy,
   closure_s / microsleep_s)): 100 % exactly when `drowsy` or `microsleep` is due.
 - `AttentiveProbability` = q (100 - max(distraction, fatigue)) + (1 - q) 50, q the confidence
@@ -24,7 +26,9 @@ Values (definitions and how the levels are computed: docs/zenoh.md):
   road-ahead pose (VSS's "normal position"), degrees, yaw > 0 = turned left, pitch > 0 = up;
   `HeadPosition.Roll` > 0 = leaning to the right (the project's roll). Not sent when unknown.
 - `ADAS.DMS.IsWarning`: an alert is active; `ADAS.DMS.IsError`: monitoring degraded (the eyes
-  unavailable too long).
+  unavailable too long) or a temporary failure in force (blocked, black, saturated or frozen
+  frames, no judgeable face; docs/monitor.md, "Failures"); a permanent failure (camera gone)
+  sends `IsError` and `IsWarning` true when raised, false when cleared (`publish_failure`).
 """
 
 from __future__ import annotations
@@ -160,7 +164,7 @@ def vss_values(record: FrameRecord, config: MonitorConfig) -> dict[str, VssValue
     distraction = 100.0 * min(
         1.0,
         max(
-            verdict.distraction_s / config.long_distraction_s,
+            verdict.distraction_s / (verdict.distraction_warn_s or config.long_distraction_s),
             verdict.window_off_road_s / config.vats_threshold_s,
         ),
     )
@@ -185,7 +189,7 @@ def vss_values(record: FrameRecord, config: MonitorConfig) -> dict[str, VssValue
         f"{DRIVER}.AttentiveProbability": round(attentive, 1),
         f"{DRIVER}.FatigueLevel": round(fatigue, 1),
         f"{DMS}.IsWarning": bool(verdict.active),
-        f"{DMS}.IsError": eyes.degraded,
+        f"{DMS}.IsError": eyes.degraded or bool(verdict.failure),
     }
     angles = {
         f"{HEAD}.Yaw": _relative(verdict.yaw_deg, verdict.neutral_yaw_deg),
@@ -242,6 +246,13 @@ class VssPublisher:
                     continue
             self.link.publish_vss(self.keys[path], vss_text(value))
             self._sent[path] = (value, t_s)
+            self.published += 1
+
+    def publish_failure(self, failed: bool) -> None:
+        """Send `ADAS.DMS.IsError` (and `IsWarning`) now: a permanent failure raised or cleared
+        outside the frame loop, when no record comes to carry it."""
+        for path in (f"{DMS}.IsError", f"{DMS}.IsWarning"):
+            self.link.publish_vss(self.keys[path], vss_text(failed))
             self.published += 1
 
     def close(self) -> None:

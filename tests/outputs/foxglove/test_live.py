@@ -84,7 +84,7 @@ def test_a_client_is_told_every_channel_subscribes_and_receives_records_and_imag
             "/roadgaze/annotations": "foxglove.ImageAnnotations",
             "/roadgaze/record": "roadgaze.record",
             "/roadgaze/limits": "roadgaze.limits",
-            "/roadgaze/alerts": "roadgaze.alert/2",
+            "/roadgaze/alerts": "roadgaze.alert/3",
             "/roadgaze/state": "roadgaze.state/4",
             "/roadgaze/log": "foxglove.Log",
         }

@@ -1,6 +1,6 @@
 """The ADDW / Euro NCAP acceptance cases on real faces: Pointing'04 stills held in a 15 fps clip.
 
-    PYTHONPATH=src python scripts/addw-real-faces.py [--data ../shared/data/pointing04-dev]
+    PYTHONPATH=src python scripts/addw-real-faces.py [--data $ROADGAZE_DATA/pointing04-dev]
         [--subjects 1-10] [--series 1]
 
 Per subject, each case is its own clip (a fresh pipeline, the default configuration): the frontal
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import os
 import sys
 import tempfile
 from pathlib import Path
@@ -25,6 +26,11 @@ from roadgaze.capture import open_source
 from roadgaze.config import Config
 from roadgaze.pipeline import Pipeline, create_detector
 from roadgaze.types import FrameRecord
+
+# The evaluation data: $ROADGAZE_DATA, else the folder beside the checkout (as the tests find it).
+DATA = Path(
+    os.environ.get("ROADGAZE_DATA") or Path(__file__).resolve().parents[2] / "shared" / "data"
+)
 
 FPS = 15.0
 ROAD_S = 3.0
@@ -55,7 +61,7 @@ def write_clip(path: Path, parts: list[tuple[Path, float]]) -> None:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data", type=Path, default=Path("../shared/data/pointing04-dev"))
+    parser.add_argument("--data", type=Path, default=DATA / "pointing04-dev")
     parser.add_argument("--subjects", default="1-10")
     parser.add_argument("--series", type=int, default=1)
     args = parser.parse_args()

@@ -1,6 +1,6 @@
 """How noisy and how biased MediaPipe's eye direction is on real faces, per axis.
 
-    PYTHONPATH=src python scripts/eye-noise.py [--data ../shared/data] [--json FILE]
+    PYTHONPATH=src python scripts/eye-noise.py [--data $ROADGAZE_DATA] [--json FILE]
 
 The figures behind the eye calibration's thresholds (docs/eyes.md, "Eye direction noise"):
 
@@ -26,12 +26,15 @@ import argparse
 import itertools
 import json
 import math
+import os
 import statistics
 import sys
 from pathlib import Path
 from typing import Any
 
 HERE = Path(__file__).resolve()
+# The evaluation data: $ROADGAZE_DATA, else the folder beside the checkout (as the tests find it).
+DATA = Path(os.environ.get("ROADGAZE_DATA") or HERE.parents[2] / "shared" / "data")
 sys.path.insert(0, str(HERE.parents[1] / "src"))
 
 from roadgaze.capture.open import open_source  # noqa: E402
@@ -154,7 +157,7 @@ def _zones(records: list[Any]) -> list[str]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--data", type=Path, default=HERE.parents[2] / "shared" / "data")
+    parser.add_argument("--data", type=Path, default=DATA)
     parser.add_argument("--json", type=Path, help="also write every figure as JSON")
     args = parser.parse_args()
     config = Config()

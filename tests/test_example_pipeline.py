@@ -27,7 +27,7 @@ def test_the_pipeline_example_prints_the_alerts_of_a_glance(
     synthetic_clip: Callable[[str], tuple[Path, Any]],
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    path, truth = synthetic_clip("0:1.5,-35:4,0:1.5")
+    path, truth = synthetic_clip("0:1.5,0/-35:4,0:1.5")  # a lap look (-35 yaw: the right mirror)
     example = load_example()
     assert example.main(["pipeline.py", str(path)]) == 0
     out = capsys.readouterr().out

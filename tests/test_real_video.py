@@ -1,4 +1,4 @@
-"""Real video as regression tests: Intel's three sample GIFs (../shared/data/videos) through the
+"""Real video as regression tests: Intel's three sample GIFs ($ROADGAZE_DATA/videos) through the
 whole pipeline with the default settings. The female sweep never reads `lap` (uncalibrated eyes
 and a neutral learned mid-sweep once put her there), the near-frontal man reads `road`, the
 two-person clip keeps its driver, and the eye calibration is in the records and on the video."""
@@ -19,7 +19,7 @@ from roadgaze.types import EyeCalibrationStatus, FrameRecord
 
 pytestmark = [
     pytest.mark.skipif(
-        not VIDEOS.is_dir(), reason="../shared/data/videos not present (evaluation data)"
+        not VIDEOS.is_dir(), reason="the evaluation videos are not present ($ROADGAZE_DATA/videos)"
     ),
     pytest.mark.slow,
 ]

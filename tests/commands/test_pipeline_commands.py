@@ -149,7 +149,10 @@ def test_bench_latency_through_a_loopback_subscriber(capsys: pytest.CaptureFixtu
     assert latency["target_p99_ms"] == pytest.approx(latency["landmarks_p99_ms"] + 2.0, abs=2e-3)
     assert latency["meets_target"] == (latency["p99_ms"] <= latency["target_p99_ms"])
     # The two parts: in the loop up to the publish (at least the landmark stage), then Zenoh.
-    assert 0 < latency["delivery_p50_ms"] < latency["p50_ms"]
+    # The publish is stamped when the put has returned; on a loaded machine the subscriber in the
+    # other process can log the arrival first (the loop's thread descheduled between the two), so
+    # the delivery part may read a fraction of a millisecond below zero, never more.
+    assert -1.0 < latency["delivery_p50_ms"] < latency["p50_ms"]
     assert latency["to_publish_p50_ms"] >= latency["landmarks_p50_ms"]
     assert latency["to_publish_p50_ms"] <= latency["p50_ms"]
 

@@ -183,6 +183,6 @@ def test_panel_lines_show_the_gaze_and_the_timers_against_their_thresholds() -> 
     lines = [line(record, FIXED) for line in PANEL_LINES]
     assert lines[2] == "zone AWAY  neutral +0.0/+0.0 deg  speed unknown (counting)"
     assert lines[3] == "off road 1.5 s  distraction 1.5/3 s  VATS window 1.5/10 s"
-    assert lines[4] == "eyes UNAVAILABLE (no eyes measured)  gaze +45/+0 deg (head)"
+    assert lines[4] == "eyes UNAVAILABLE (no eyes measured)  gaze +45/+0 deg (head)  eyes none"
     without_thresholds = [line(record, None) for line in PANEL_LINES][3]
     assert without_thresholds == "off road 1.5 s  distraction 1.5 s  VATS window 1.5 s"

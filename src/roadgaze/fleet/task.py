@@ -115,7 +115,7 @@ def fingerprints_match(stored: Any, current: dict[str, Any], content_hash: bool)
     with `content_hash`, else the same size and modification time."""
     if not isinstance(stored, dict) or not isinstance(stored.get("input"), dict):
         return False
-    if any(stored.get(key) != current[key] for key in ("version", "config", "drive", "speed")):
+    if any(stored.get(key) != current.get(key) for key in ("version", "config", "drive", "speed")):
         return False
     keys = ("size", "sha256") if content_hash else ("size", "mtime_ns")
     return all(stored["input"].get(key) == current["input"][key] for key in keys)

@@ -5,6 +5,8 @@ from types import ModuleType
 from roadgaze.commands import (
     batch,
     bench,
+    conformance,
+    data,
     demo,
     doctor,
     estimate,
@@ -18,6 +20,7 @@ from roadgaze.commands import (
     run,
     schema,
     security,
+    speed,
     synth,
 )
 
@@ -25,12 +28,15 @@ COMMANDS: tuple[ModuleType, ...] = (
     demo,
     run,
     listen,
+    speed,
     router,
     replay,
     batch,
+    conformance,
     recover,
     bench,
     evaluate,
+    data,
     estimate,
     synth,
     model,

@@ -12,7 +12,7 @@ import logging
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from roadgaze.commands.options import common_options
+from roadgaze.commands.options import add_speed_options, common_options
 from roadgaze.config import Config
 from roadgaze.errors import ConfigError
 from roadgaze.logs import log_written
@@ -35,7 +35,10 @@ def register(subparsers: Any) -> None:
         help="replay many recorded drives to Parquet, resumable, with a fleet summary and report",
         description="Run the pipeline over every video under a folder (searched recursively) or "
         "listed in a CSV manifest (columns: path, and optionally drive_id, driver_id, "
-        "vehicle_id, start_time). Writes DIR/frames/<drive_id>.parquet, "
+        "vehicle_id, start_time, speed_track). A drive's vehicle speed comes from its speed_track, "
+        "else from <stem>.speed.csv or .speed.parquet beside its video (t_s,kmh), else it is "
+        "unknown (taken as moving); --speed-kmh sets one for all. Writes "
+        "DIR/frames/<drive_id>.parquet, "
         "DIR/alerts/<drive_id>.parquet, DIR/summary.parquet and DIR/report.html. A re-run skips "
         "drives whose outputs match their input and configuration. Exit status 0 when all "
         "drives succeeded, 3 when some failed, 2 for bad arguments, 130 when stopped.",
@@ -61,6 +64,14 @@ def register(subparsers: Any) -> None:
         "RAY_ADDRESS, else a local Ray instance",
     )
     parser.add_argument(
+        "--ray-timeout",
+        type=float,
+        default=30.0,
+        metavar="S",
+        help="fail (exit 2, naming the address) when no Ray cluster answers at the address in S "
+        "seconds (default 30)",
+    )
+    parser.add_argument(
         "--hash",
         action="store_true",
         help="recognise unchanged inputs by their SHA-256 instead of size and modification time",
@@ -74,6 +85,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print the run's figures as JSON")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_speed_options(parser, track=False)
     parser.set_defaults(handler=run)
 
 
@@ -94,6 +106,12 @@ def run(args: argparse.Namespace, config: Config) -> int:
         raise ConfigError(f"--workers must be at least 1, found {args.workers}")
     if args.retries < 0:
         raise ConfigError(f"--retries must be 0 or more, found {args.retries}")
+    if not 0 < args.ray_timeout <= 3600:
+        raise ConfigError(f"--ray-timeout must be within 0-3600 s, found {args.ray_timeout:g}")
+    if args.speed_kmh is not None:
+        from roadgaze.capture.speed_track import recorded_speed
+
+        recorded_speed(None, constant_kmh=args.speed_kmh)  # a bad speed said before any work
     if args.ray_address is not None and args.engine != "ray":
         raise ConfigError("--ray-address needs --engine ray")
     if args.engine == "ray":
@@ -109,9 +127,11 @@ def run(args: argparse.Namespace, config: Config) -> int:
         engine=args.engine,
         workers=args.workers,
         ray_address=args.ray_address,
+        ray_timeout_s=args.ray_timeout,
         content_hash=args.hash,
         retries=args.retries,
         progress=not args.no_progress,
+        speed_kmh=args.speed_kmh,
     )
     outcome = run_batch(drives, config, options)
     report(outcome, out_dir)
@@ -140,6 +160,12 @@ def report(outcome: BatchOutcome, out_dir: Path) -> None:
         outcome.workers,
         "" if outcome.workers == 1 else "s",
     )
+    if figures["worker_deaths"]:
+        log.warning(
+            "batch: %s worker process deaths, %s drives tried again (see batch.log)",
+            figures["worker_deaths"],
+            figures["retries"],
+        )
     for result in outcome.failed[:FAILED_LISTED]:
         log.warning("batch: failed %s (%s): %s", result.drive_id, result.path, result.error)
     if len(outcome.failed) > FAILED_LISTED:

@@ -107,6 +107,28 @@ def with_zenoh_args(config: Config, args: Any) -> Config:
     return config.model_copy(update={"zenoh": zenoh_config_from_args(config.zenoh, args)})
 
 
+def add_speed_options(parser: Any, *, track: bool = True) -> None:
+    """--speed-track and --speed-kmh: the vehicle speed of a recorded drive
+    (`roadgaze.capture.speed_track`)."""
+    group = parser.add_argument_group("vehicle speed of a recorded drive")
+    if track:
+        group.add_argument(
+            "--speed-track",
+            type=Path,
+            metavar="FILE",
+            help="CSV or Parquet with columns t_s,kmh on the video's timeline (default: "
+            "VIDEO's <stem>.speed.csv or .speed.parquet beside it, when there is one); the last "
+            "sample holds for zenoh.speed_timeout_s, before the first and in gaps the speed is "
+            "unknown (taken as moving)",
+        )
+    group.add_argument(
+        "--speed-kmh",
+        type=float,
+        metavar="N",
+        help="one speed in km/h for the whole drive (instead of a track)",
+    )
+
+
 def check_seconds(option: str, value: float | None) -> None:
     """Raise ConfigError unless `value` (when given) is a finite number of seconds > 0: argparse
     takes 'nan' and 'inf' as floats, and a loop waiting for NaN seconds never ends."""

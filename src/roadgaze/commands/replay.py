@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from roadgaze.commands.options import (
     PLOT_SUFFIXES,
+    add_speed_options,
     add_zenoh_options,
     check_output_paths,
     common_options,
@@ -28,7 +29,7 @@ from roadgaze.types import Frame, FrameRecord
 
 if TYPE_CHECKING:
     from roadgaze.capture import SourceInfo
-    from roadgaze.pipeline import RunSummary, Sink
+    from roadgaze.pipeline import RunSummary, Sink, SpeedSource, VehicleSpeed
 
 log = logging.getLogger("roadgaze.replay")
 
@@ -89,8 +90,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--publish",
         action="store_true",
-        help="publish yaw, alerts, liveliness and state on Zenoh, stamped with the video's time",
+        help="publish yaw, alerts, liveliness and state on Zenoh, stamped with the video's time "
+        "(exit 4 when some alerts never reached the bus, each named)",
     )
+    add_speed_options(parser)
     add_zenoh_options(parser)
 
 
@@ -182,6 +185,7 @@ def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) ->
 
 def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.capture import open_source
+    from roadgaze.capture.speed_track import recorded_speed
     from roadgaze.daemon import bus_outputs
     from roadgaze.errors import ConfigError
     from roadgaze.outputs.video import FOURCC_BY_SUFFIX
@@ -191,8 +195,9 @@ def run(args: argparse.Namespace, config: Config) -> int:
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
     outputs = {"--out": args.out, "--csv": args.csv, "--plot": args.plot}
+    speed_input = {} if args.speed_track is None else {"--speed-track": args.speed_track}
     check_output_paths(
-        {"VIDEO": args.source},
+        {"VIDEO": args.source, **speed_input},
         {**outputs, "--annotate": args.annotate, "--mcap": args.mcap},
         {"--plot": PLOT_SUFFIXES, "--annotate": tuple(FOURCC_BY_SUFFIX), "--mcap": (".mcap",)},
     )
@@ -201,6 +206,9 @@ def run(args: argparse.Namespace, config: Config) -> int:
 
         require_foxglove("--mcap")
     config = with_zenoh_args(config, args)
+    speed_choice = recorded_speed(
+        args.source, args.speed_track, args.speed_kmh, config.zenoh.speed_timeout_s
+    )
     stats = ReplayStats()
     with ExitStack() as stack:
         stack.enter_context(sigterm_as_interrupt())
@@ -217,10 +225,19 @@ def run(args: argparse.Namespace, config: Config) -> int:
                 config, args.source, args.mcap, bus.health.state_json, block_on_images=flat_out
             )
             sinks.append(stack.enter_context(recorder))
-        pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
+        speed: VehicleSpeed | SpeedSource = bus.speed
+        origin = "the bus" if args.publish else "nowhere: unknown, taken as moving"
+        if speed_choice.speed is not None:  # a recorded drive's own speed wins over the bus
+            speed, origin = speed_choice.speed, speed_choice.origin
+        log.info("replay %s: vehicle speed from %s", args.source, origin)
+        pipeline = Pipeline.from_config(config, detector, speed=speed)
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
     fill_offline(args, config)
     report(args, summary, stats)
+    if bus.undelivered():
+        from roadgaze.daemon import EXIT_UNDELIVERED
+
+        return EXIT_UNDELIVERED  # the warning naming them was logged when the link closed
     return 0
 
 

@@ -10,15 +10,15 @@ its own when it is processed.
 
 from __future__ import annotations
 
-import csv
 import hashlib
 import os
 import re
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from pathlib import Path
 
+from roadgaze.csv_rows import read_csv_rows
 from roadgaze.errors import ConfigError
 
 VIDEO_SUFFIXES = frozenset(
@@ -28,9 +28,9 @@ VIDEO_SUFFIXES = frozenset(
 """File suffixes (any case) taken as drives when a folder is searched (`.mcap`: a recording with a
 camera channel, `roadgaze.capture.McapSource`)."""
 
-MANIFEST_COLUMNS = ("path", "drive_id", "driver_id", "vehicle_id", "start_time")
-"""The columns a manifest may have; `path` is required, relative paths are relative to the
-manifest's folder."""
+MANIFEST_COLUMNS = ("path", "drive_id", "driver_id", "vehicle_id", "start_time", "speed_track")
+"""The columns a manifest may have; `path` is required, relative paths (`path`, `speed_track`)
+are relative to the manifest's folder."""
 
 DRIVE_ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,159}$")
 """A drive id: letters, digits, `.`, `_` and `-`, starting with a letter or digit, at most 160
@@ -49,6 +49,9 @@ class Drive:
     vehicle_id: str | None = None
     start_time: datetime | None = None
     """When the recording started, timezone-aware (UTC when the input gave no zone)."""
+    speed_track: Path | None = None
+    """The drive's `t_s,kmh` speed track when the manifest names one; else the one beside the
+    video, if any (`roadgaze.capture.speed_track`)."""
 
 
 def discover_drives(input_path: Path) -> tuple[Drive, ...]:
@@ -121,13 +124,7 @@ def read_manifest(manifest: Path) -> tuple[Drive, ...]:
     Raises `ConfigError` for a missing `path` column, unknown columns, an empty path, a bad or
     duplicate `drive_id`, a `start_time` that is not ISO 8601, or no rows.
     """
-    try:
-        with manifest.open(newline="", encoding="utf-8-sig") as handle:
-            reader = csv.DictReader(handle)
-            header = [name.strip() for name in reader.fieldnames or []]
-            rows = list(reader)
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise ConfigError(f"cannot read manifest {manifest}: {exc}") from None
+    header, rows = read_csv_rows(manifest, ConfigError, "manifest")
     if "path" not in header:
         raise ConfigError(
             f"manifest {manifest} has no 'path' column (found: {', '.join(header) or 'nothing'}); "
@@ -150,7 +147,7 @@ def read_manifest(manifest: Path) -> tuple[Drive, ...]:
         drives.append(_drive_of_row(row, base, f"manifest {manifest} line {line}"))
     ids = derived_drive_ids([_relative_or_absolute(d.path, base) for d in drives])
     drives = [
-        d if d.drive_id else Drive(derived, d.path, d.driver_id, d.vehicle_id, d.start_time)
+        d if d.drive_id else replace(d, drive_id=derived)
         for d, derived in zip(drives, ids, strict=True)
     ]
     duplicates = sorted(name for name, n in Counter(d.drive_id for d in drives).items() if n > 1)
@@ -178,9 +175,11 @@ def _drive_of_row(row: dict[str, str], base: Path, where: str) -> Drive:
             f"{where}: drive_id {drive_id!r} is not filesystem-safe; use letters, digits, "
             "'.', '_' and '-' (starting with a letter or digit, at most 160 characters)"
         )
+    track = Path(row["speed_track"]).expanduser() if row.get("speed_track") else None
     return Drive(
         drive_id=drive_id,
         path=path if path.is_absolute() else base / path,
+        speed_track=None if track is None else track if track.is_absolute() else base / track,
         driver_id=row.get("driver_id") or None,
         vehicle_id=row.get("vehicle_id") or None,
         start_time=parse_start_time(row.get("start_time", ""), where),

@@ -50,6 +50,30 @@ class DriveTask:
     """Fingerprint the input by its SHA-256 instead of its size and modification time."""
     version: str = __version__
     """The roadgaze version of the batch; a worker with another version refuses the drive."""
+    speed_kmh: float | None = None
+    """One vehicle speed for every drive (`--speed-kmh`) instead of their speed tracks."""
+
+
+def speed_fingerprint(task: DriveTask) -> dict[str, Any]:
+    """What the drive's vehicle speed depends on: the constant, or the track file's size and
+    modification time (its SHA-256 with `content_hash`); never raises (a bad track fails the
+    drive when it runs)."""
+    from roadgaze.capture.speed_track import track_beside
+
+    if task.speed_kmh is not None:
+        return {"kmh": task.speed_kmh}
+    try:
+        path = task.drive.speed_track or track_beside(task.drive.path)
+        if path is None:
+            return {}
+        stat = path.stat()
+        found: dict[str, Any] = {"track": path.name, "size": stat.st_size}
+        found["mtime_ns"] = stat.st_mtime_ns
+        if task.content_hash:
+            found["sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+        return found
+    except (RoadgazeError, OSError) as exc:
+        return {"error": str(exc)}
 
 
 def output_paths(out_dir: Path, drive_id: str) -> tuple[Path, Path]:
@@ -82,6 +106,7 @@ def fingerprint_of(task: DriveTask) -> dict[str, Any]:
         "version": task.version,
         "config": config_hash(task.config),
         "drive": [drive.driver_id, drive.vehicle_id, DriveResult.of(drive, "ok").start_time],
+        "speed": speed_fingerprint(task),
     }
 
 
@@ -90,7 +115,7 @@ def fingerprints_match(stored: Any, current: dict[str, Any], content_hash: bool)
     with `content_hash`, else the same size and modification time."""
     if not isinstance(stored, dict) or not isinstance(stored.get("input"), dict):
         return False
-    if any(stored.get(key) != current[key] for key in ("version", "config", "drive")):
+    if any(stored.get(key) != current[key] for key in ("version", "config", "drive", "speed")):
         return False
     keys = ("size", "sha256") if content_hash else ("size", "mtime_ns")
     return all(stored["input"].get(key) == current["input"][key] for key in keys)
@@ -173,7 +198,8 @@ def process_drive(task: DriveTask) -> DriveResult:
 
 def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> DriveResult:
     from roadgaze.capture import open_file
-    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.capture.speed_track import recorded_speed
+    from roadgaze.pipeline import Pipeline, create_detector, no_speed
 
     drive, config = task.drive, task.config
     frames_path, alerts_path = output_paths(task.out_dir, drive.drive_id)
@@ -183,6 +209,8 @@ def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> 
         "vehicle_id": drive.vehicle_id,
         "start_time": drive.start_time,
     }
+    hold_s = config.zenoh.speed_timeout_s
+    speed = recorded_speed(drive.path, drive.speed_track, task.speed_kmh, hold_s).speed
     with ExitStack() as stack:
         source = stack.enter_context(open_file(drive.path, config))
         detector = create_detector(config)
@@ -191,7 +219,10 @@ def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> 
         frames = stack.enter_context(AtomicParquetWriter(frames_path, frames_schema(), constant))
         alerts = stack.enter_context(AtomicParquetWriter(alerts_path, alerts_schema(), constant))
         recorder = DriveRecorder(frames, alerts)
-        summary = Pipeline.from_config(config, detector).run(source, [recorder], stop=_stop)
+        pipeline = Pipeline.from_config(
+            config, detector, speed=speed if speed is not None else no_speed
+        )
+        summary = pipeline.run(source, [recorder], stop=_stop)
         if _stop is not None and _stop.is_set():
             return DriveResult.of(drive, "interrupted", error="stopped before the end")
         if summary.frames == 0:

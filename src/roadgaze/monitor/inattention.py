@@ -275,7 +275,7 @@ def step(
             active.append(raised.kind)
 
     neutral_yaw, neutral_pitch, yaw_learned_s, pitch_learned_s = learn_neutral(
-        config, state, look.yaw_deg, look.pitch_deg, t_s
+        config, state, look.yaw_deg, look.pitch_deg, t_s, sample.yaw_rate_dps
     )
     new_state = replace(
         state,

@@ -23,6 +23,7 @@ def learn_neutral(
     yaw_deg: float | None,
     pitch_deg: float | None,
     t_s: float,
+    yaw_rate_dps: float | None = None,
 ) -> tuple[float, float, float, float]:
     """The neutral yaw and pitch after this sample and the time each has learned from.
 
@@ -33,7 +34,9 @@ def learn_neutral(
     road zone at first, is still learned. The yaw test is not: a sample in the hysteresis band
     may be a glance held just past the road's edge, and learning from it would walk the neutral
     after the glance until the glance reads as road (fail-safe: an alert is never learned
-    away). The gain is the larger of
+    away). Nor does a head turning faster than `neutral_max_rate_dps` (`yaw_rate_dps`, None:
+    unknown) teach: it sweeps through the road on its way elsewhere (a single such sample would
+    otherwise set the neutral at the start of a drive). The gain is the larger of
     the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
     over the time learned so far): the neutral settles on the driver's road pose within seconds
     of the start and then follows it slowly.
@@ -44,7 +47,14 @@ def learn_neutral(
         return yaw, pitch, yaw_s, pitch_s
     ahead = abs(yaw_deg - yaw) <= config.road_half_width_deg - config.hysteresis_deg
     level = pitch_deg is None or abs(pitch_deg) <= config.neutral_pitch_limit_deg
-    if not (ahead and level):
+    limit = config.neutral_max_rate_dps
+    steady = (
+        yaw_rate_dps is None
+        or limit is None
+        or not math.isfinite(yaw_rate_dps)
+        or abs(yaw_rate_dps) <= limit
+    )
+    if not (ahead and level and steady):
         return yaw, pitch, yaw_s, pitch_s
     dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
     slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)

@@ -7,10 +7,16 @@ from roadgaze.pipeline.loop import (
     Pipeline,
     ProcessedFrame,
     Sink,
-    SpeedSource,
     StopSignal,
     create_detector,
+)
+from roadgaze.pipeline.speed import (
+    BusSpeed,
+    ConstantSpeed,
+    SpeedSource,
+    VehicleSpeed,
     no_speed,
+    vehicle_speed,
 )
 from roadgaze.pipeline.timing import STAGES, RunSummary, StageStats, StageTimes, StageTimings
 
@@ -19,6 +25,8 @@ __all__ = [
     "READ_AHEAD_FRAMES",
     "STAGES",
     "STOP_GRACE_S",
+    "BusSpeed",
+    "ConstantSpeed",
     "Pipeline",
     "ProcessedFrame",
     "RunSummary",
@@ -28,6 +36,8 @@ __all__ = [
     "StageTimes",
     "StageTimings",
     "StopSignal",
+    "VehicleSpeed",
     "create_detector",
     "no_speed",
+    "vehicle_speed",
 ]

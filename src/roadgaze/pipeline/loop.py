@@ -28,6 +28,7 @@ from roadgaze.monitor import Monitor
 from roadgaze.monitor.failures import check_frame
 from roadgaze.pipeline.handoff import Handoff
 from roadgaze.pipeline.runtime import Collector, loop_runtime
+from roadgaze.pipeline.speed import SpeedSource, VehicleSpeed, no_speed, vehicle_speed
 from roadgaze.pipeline.steps import (
     Decoded,
     DetectorSteps,
@@ -49,14 +50,6 @@ INFER_AHEAD_FRAMES = 1
 STOP_GRACE_S = 1.0
 """After a stop is asked for, how long the frame in hand may take before a live source is closed
 (which unblocks a loop waiting for a lost camera)."""
-
-SpeedSource = Callable[[], float | None]
-"""The vehicle speed in km/h for the monitor; None when unknown (taken as moving)."""
-
-
-def no_speed() -> float | None:
-    """The speed source of a replay without a bus: always unknown, i.e. moving (fail-safe)."""
-    return None
 
 
 class StopSignal(Protocol):
@@ -91,7 +84,7 @@ class Pipeline:
         detector: LandmarkDetector,
         pose: PoseEstimator | None = None,
         monitor: Monitor | None = None,
-        speed: SpeedSource = no_speed,
+        speed: SpeedSource | VehicleSpeed = no_speed,
         clock: Callable[[], float] = time.perf_counter,
         eyes: EyesConfig | None = None,
     ) -> None:
@@ -99,7 +92,8 @@ class Pipeline:
         self.eyes = eyes if eyes is not None else EyesConfig()
         self.pose = pose if pose is not None else PoseEstimator()
         self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
-        self.speed = speed
+        self.speed = vehicle_speed(speed)
+        """The vehicle speed at each frame's time (a zero-argument source is the bus's)."""
         self._clock = clock
         self._steps = DetectorSteps.of(detector)
         self._frame_received_s = math.nan
@@ -108,7 +102,10 @@ class Pipeline:
 
     @classmethod
     def from_config(
-        cls, config: Config, detector: LandmarkDetector, speed: SpeedSource = no_speed
+        cls,
+        config: Config,
+        detector: LandmarkDetector,
+        speed: SpeedSource | VehicleSpeed = no_speed,
     ) -> Pipeline:
         return cls(
             detector=detector,
@@ -147,7 +144,7 @@ class Pipeline:
         frame_check, self._previous_grey = check_frame(frame.image, self._previous_grey)
         sample = replace(sample, frame_check=frame_check)
         after_smoothing = clock()
-        alerts = self.monitor.update(sample, self.speed())
+        alerts = self.monitor.update(sample, self.speed.kmh_at(frame.t_s))
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)
         after_monitor = clock()
         times = StageTimes(
@@ -272,7 +269,8 @@ def _close_when_stopped(stop: StopSignal, source: FrameSource, done: threading.E
 
 
 def create_detector(config: Config) -> LandmarkDetector:
-    """The production detector: MediaPipe FaceLandmarker in VIDEO mode (model via model_store)."""
-    from roadgaze.landmarks import MediaPipeLandmarker
+    """The production detector: the face landmarker in VIDEO mode on `landmarks.engine` (model via
+    model_store)."""
+    from roadgaze.landmarks import Landmarker
 
-    return MediaPipeLandmarker.from_config(config, video=True)
+    return Landmarker.from_config(config, video=True)

@@ -1,0 +1,157 @@
+"""A scenario as a recorded drive: its frames, `NAME.speed.csv`, `NAME.truth.csv` (`NAME.mkv`).
+
+The head pose and eyes of the scenario (driver's frame) go through the camera mounting
+(`roadgaze.pose.mounting.head_to_camera`) and are rendered as that camera sees the face; sensor
+noise goes on every frame (a held pose is not a frozen camera), sunglasses over the eyes when the
+scenario wears them. A covered lens is a dark flat frame, no face the cabin without the driver,
+frozen frames the last frame again, byte for byte. `RenderedSource` hands the frames to the loop
+as a video file would, rendered in the loop's decode thread (so rendering overlaps MediaPipe);
+with a clip path it also writes them losslessly (FFV1), so `roadgaze replay NAME.mkv` shows the
+same drive. The speed track (`roadgaze.capture.speed_track`) holds the scenario's speed every
+`SPEED_PERIOD_S`; without a speed there is no track (unknown speed).
+"""
+
+from __future__ import annotations
+
+import zlib
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from roadgaze.capture.base import SourceBase, SourceInfo, SourceStatus
+from roadgaze.conformance.model import CameraState, Scenario
+from roadgaze.pose.mounting import Cabin, head_to_camera, mounting_for
+from roadgaze.synth.clip import write_truth_csv
+from roadgaze.synth.effects import NoiseBank, covered_frame, sunglasses
+from roadgaze.synth.eyes import EyeRenderer, EyeState
+from roadgaze.synth.renderer import ImageBGR
+from roadgaze.synth.timeline import Keyframe, Timeline
+from roadgaze.types import FloatArray, Frame
+
+SPEED_PERIOD_S = 0.5
+"""A speed sample every half second (a CAN speed signal comes at 10-50 Hz; the track holds)."""
+CLIP_SUFFIX = ".mkv"
+
+
+def timeline_of(scenario: Scenario) -> Timeline:
+    """The scenario's head and eye poses (driver's frame) as a synth timeline."""
+    return Timeline(
+        tuple(
+            Keyframe(
+                s.yaw_deg, s.pitch_deg, s.duration_s, s.eye_yaw_deg, s.eye_pitch_deg, s.openness
+            )
+            for s in scenario.segments
+        )
+    )
+
+
+def camera_states(scenario: Scenario, t_s: FloatArray) -> list[CameraState]:
+    """What the camera delivers at each time (the segment the time falls in)."""
+    ends = np.cumsum([segment.duration_s for segment in scenario.segments])
+    index = np.minimum(np.searchsorted(ends, t_s, side="right"), len(ends) - 1)
+    return [scenario.segments[int(i)].camera for i in index]
+
+
+def write_speed_track(path: Path, speed_kmh: float, duration_s: float) -> None:
+    """`t_s,kmh` every `SPEED_PERIOD_S` from 0 to past `duration_s`, at one speed."""
+    count = int(duration_s / SPEED_PERIOD_S) + 2
+    rows = "".join(f"{i * SPEED_PERIOD_S:.2f},{speed_kmh:g}\n" for i in range(count))
+    path.write_text("t_s,kmh\n" + rows, encoding="utf-8")
+
+
+class ScenarioRenderer:
+    """Renders scenarios with one `EyeRenderer` (built once: it runs MediaPipe on the photo; give
+    it `eyeball_at_rest=True`, so eyes at rest turn with the head as an eyeball does); identical
+    poses are rendered once per scenario."""
+
+    def __init__(self, renderer: EyeRenderer, fps: float, cabin: Cabin = "lhd") -> None:
+        self.renderer = renderer
+        self.fps = fps
+        self.cabin = cabin
+
+    def _face(
+        self, scenario: Scenario, row: FloatArray, cache: dict[tuple[float, ...], ImageBGR]
+    ) -> ImageBGR:
+        mounting = mounting_for(scenario.mounting, self.cabin)
+        yaw, pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
+        key = tuple(round(float(v), 4) for v in (yaw, pitch, *row[3:6]))
+        if key not in cache:
+            state = EyeState.both(float(row[3]), float(row[4]), float(row[5]))
+            frame = self.renderer.render_eyes(yaw, pitch, state)
+            if scenario.sunglasses:
+                frame = sunglasses(frame, self.renderer, yaw, pitch)
+            cache[key] = frame
+        return cache[key]
+
+    def frames(self, scenario: Scenario) -> Iterator[ImageBGR]:
+        """Every frame of the scenario, in order (rendered as they are asked for)."""
+        truth = timeline_of(scenario).eye_truth(self.fps)
+        states = camera_states(scenario, truth[:, 0])
+        rng = np.random.default_rng(zlib.crc32(scenario.name.encode()))
+        noise = NoiseBank(self.renderer.size, rng)
+        cache: dict[tuple[float, ...], ImageBGR] = {}
+        last: ImageBGR | None = None
+        for row, state in zip(truth, states, strict=True):
+            if state == "frozen" and last is not None:
+                frame = last
+            elif state == "covered":
+                frame = covered_frame(self.renderer.size, rng)
+            elif state == "no_face":
+                frame = noise(self.renderer.background)
+            else:
+                frame = noise(self._face(scenario, row, cache))
+            last = frame
+            yield frame
+
+    def write_side_files(self, scenario: Scenario, folder: Path) -> Path | None:
+        """`NAME.truth.csv` and, with a speed, `NAME.speed.csv` in `folder`; returns the track."""
+        folder.mkdir(parents=True, exist_ok=True)
+        write_truth_csv(
+            folder / f"{scenario.name}.truth.csv", timeline_of(scenario).eye_truth(self.fps)
+        )
+        track = folder / f"{scenario.name}.speed.csv"
+        track.unlink(missing_ok=True)
+        if scenario.speed_kmh is None:
+            return None
+        write_speed_track(track, scenario.speed_kmh, scenario.duration_s)
+        return track
+
+
+class RenderedSource(SourceBase):
+    """A scenario's frames as a file-like `FrameSource` (not live, at the renderer's rate);
+    with `clip` set, each frame is also written to that lossless video."""
+
+    def __init__(self, renderer: ScenarioRenderer, scenario: Scenario, clip: Path | None) -> None:
+        self._renderer = renderer
+        self._scenario = scenario
+        self._clip = clip
+        self._status = SourceStatus()
+        width, height = renderer.renderer.size
+        count = max(1, round(scenario.duration_s * renderer.fps))
+        self._info = SourceInfo(scenario.name, False, renderer.fps, count, width, height)
+
+    @property
+    def info(self) -> SourceInfo:
+        return self._info
+
+    def __iter__(self) -> Iterator[Frame]:
+        from roadgaze.outputs.video import open_video_writer
+
+        writer: Any = None
+        if self._clip is not None:
+            size = (self._info.width, self._info.height)
+            writer = open_video_writer(self._clip, self._renderer.fps, size, "FFV1")
+        try:
+            for index, image in enumerate(self._renderer.frames(self._scenario)):
+                if writer is not None:
+                    writer.write(image)
+                self._status = SourceStatus(frames_delivered=index + 1)
+                yield Frame(index=index, t_s=index / self._renderer.fps, image=image)
+        finally:
+            if writer is not None:
+                writer.release()
+
+    def close(self) -> None:
+        return None

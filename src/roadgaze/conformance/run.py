@@ -1,0 +1,114 @@
+"""Runs the suite: each scenario rendered, replayed through the real service, judged.
+
+Each drive goes through the same loop as `roadgaze replay` (`Pipeline`, MediaPipe in VIDEO mode,
+a fresh landmarker per drive) with the vehicle speed read from the drive's speed track the way
+`replay` and `batch` read it (`roadgaze.capture.speed_track.recorded_speed`), and the service
+told the scenario's camera mounting. Every alert is kept; each requirement is judged on them.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Sequence
+from contextlib import ExitStack
+from dataclasses import dataclass
+from pathlib import Path
+
+from roadgaze.capture import FrameSource
+from roadgaze.config import Config
+from roadgaze.conformance.clips import CLIP_SUFFIX, RenderedSource, ScenarioRenderer
+from roadgaze.conformance.model import Outcome, Scenario, judge
+from roadgaze.types import Frame, FrameRecord
+
+log = logging.getLogger(__name__)
+
+Alerts = list[tuple[str, str, float]]
+"""(kind, level, t_s) of every alert of a drive, in order."""
+
+
+class AlertLog:
+    """A sink keeping every alert of the drive."""
+
+    def __init__(self) -> None:
+        self.alerts: Alerts = []
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        for alert in record.alerts:
+            self.alerts.append((alert.kind.value, alert.level.value, alert.t_s))
+
+    def close(self) -> None:
+        return None
+
+
+def scenario_config(config: Config, scenario: Scenario) -> Config:
+    """`config` with the service told where the scenario's camera sits."""
+    monitor = config.monitor.model_dump()
+    monitor["camera_mounting"] = scenario.mounting
+    return config.model_copy(update={"monitor": type(config.monitor).model_validate(monitor)})
+
+
+def replay_drive(source: FrameSource, track: Path | None, config: Config) -> Alerts:
+    """Every alert the service raises on `source`, the speed from `track` (None: unknown)."""
+    from roadgaze.capture.speed_track import recorded_speed
+    from roadgaze.pipeline import Pipeline, create_detector, no_speed
+
+    speed = recorded_speed(None, track, hold_s=config.zenoh.speed_timeout_s).speed
+    sink = AlertLog()
+    with ExitStack() as stack:
+        stack.enter_context(source)
+        detector = create_detector(config)
+        stack.callback(detector.close)
+        pipeline = Pipeline.from_config(
+            config, detector, speed=speed if speed is not None else no_speed
+        )
+        pipeline.run(source, [sink])
+    return sink.alerts
+
+
+def outcomes_of(scenario: Scenario, alerts: Alerts) -> list[Outcome]:
+    """Each requirement of `scenario` judged on the drive's alerts."""
+    shown = tuple(f"{kind}:{level}@{t_s:.2f}" for kind, level, t_s in alerts)
+    results = []
+    for requirement in scenario.requirements:
+        start_s = scenario.start_of(requirement.from_label)
+        measured, passed = judge(requirement, start_s, alerts)
+        results.append(Outcome(scenario.name, requirement, measured, passed, shown))
+    return results
+
+
+@dataclass(frozen=True, slots=True)
+class SuiteRun:
+    """The outcomes of a run, in scenario order, and how long it took."""
+
+    outcomes: tuple[Outcome, ...]
+    scenarios: int
+    wall_s: float
+
+    @property
+    def failed(self) -> tuple[Outcome, ...]:
+        return tuple(outcome for outcome in self.outcomes if not outcome.passed)
+
+
+def run_suite(
+    scenarios: Sequence[Scenario],
+    config: Config,
+    clips_dir: Path,
+    renderer: ScenarioRenderer,
+    on_scenario: Callable[[Scenario, list[Outcome]], None] | None = None,
+    save_clips: bool = False,
+) -> SuiteRun:
+    """Render, replay and judge every scenario; each one's truth and speed track go to
+    `clips_dir`, with its video too when `save_clips`."""
+    started = time.perf_counter()
+    outcomes: list[Outcome] = []
+    for scenario in scenarios:
+        track = renderer.write_side_files(scenario, clips_dir)
+        clip = clips_dir / f"{scenario.name}{CLIP_SUFFIX}" if save_clips else None
+        source = RenderedSource(renderer, scenario, clip)
+        alerts = replay_drive(source, track, scenario_config(config, scenario))
+        results = outcomes_of(scenario, alerts)
+        outcomes.extend(results)
+        if on_scenario is not None:
+            on_scenario(scenario, results)
+    return SuiteRun(tuple(outcomes), len(scenarios), time.perf_counter() - started)

@@ -1,0 +1,101 @@
+"""The scenarios' frames: noise on every frame, a covered lens, frozen frames byte for byte, no
+face, sunglasses, the face as a camera at a mounting preset sees it, the speed track."""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from roadgaze.capture.speed_track import read_speed_track
+from roadgaze.conformance.clips import RenderedSource, ScenarioRenderer
+from roadgaze.conformance.model import Scenario, Segment
+from roadgaze.pose.mounting import head_to_camera, mounting_for
+from roadgaze.synth.eyes import EyeState
+
+FPS = 5.0
+
+
+@pytest.fixture(scope="module")
+def renderer() -> ScenarioRenderer:
+    from roadgaze.synth import EyeRenderer, load_photo
+
+    return ScenarioRenderer(EyeRenderer(load_photo(), (160, 160), eyeball_at_rest=True), FPS)
+
+
+def grey(frame: Any) -> Any:
+    return frame.astype(np.float64).mean(axis=2)
+
+
+def test_camera_states_and_noise(renderer: ScenarioRenderer) -> None:
+    segments = (
+        Segment(1.0),
+        Segment(1.0, camera="frozen"),
+        Segment(0.6, camera="covered"),
+        Segment(0.6, camera="no_face"),
+    )
+    frames = list(renderer.frames(Scenario("states", "", segments, 70.0, ())))
+    assert len(frames) == 16
+    ahead = [grey(f) for f in frames[:5]]
+    for first, second in itertools.pairwise(ahead):
+        assert np.abs(first - second).mean() > 1.0  # a held pose is not a frozen camera
+    assert all(np.array_equal(frame, frames[4]) for frame in frames[5:10])  # frozen: repeats
+    for frame in frames[10:13]:
+        assert grey(frame).mean() < 12.0 and grey(frame).std() < 4.0  # covered: dark and flat
+    background = renderer.renderer.background.astype(np.float64)
+    for frame in frames[13:]:
+        assert np.abs(frame.astype(np.float64) - background).mean() < 3.0  # the cabin, no face
+
+
+def test_a_preset_renders_the_face_as_its_camera_sees_it(renderer: ScenarioRenderer) -> None:
+    scenario = Scenario("pillar", "", (Segment(0.2, 0.0, -35.0),), 70.0, (), mounting="a_pillar")
+    frame = next(renderer.frames(scenario)).astype(np.float64)
+    yaw, pitch, _ = head_to_camera(mounting_for("a_pillar"), 0.0, -35.0)
+    assert yaw < -20.0  # the camera on the left pillar sees the face turned to its right
+    seen = renderer.renderer.render_eyes(yaw, pitch, EyeState()).astype(np.float64)
+    front = renderer.renderer.render_eyes(0.0, -35.0, EyeState()).astype(np.float64)
+    assert np.abs(frame - seen).mean() < 3.0 < np.abs(frame - front).mean()
+
+
+def test_sunglasses_cover_the_eyes(renderer: ScenarioRenderer) -> None:
+    plain, dark = (
+        next(renderer.frames(Scenario("g", "", (Segment(0.2),), 70.0, (), sunglasses=glasses)))
+        for glasses in (False, True)
+    )
+    changed = np.abs(grey(plain) - grey(dark)) > 40
+    assert 0.005 < changed.mean() < 0.08  # two lenses: a small part of the frame
+    assert grey(dark)[changed].mean() < 30.0
+
+
+def test_side_files_and_the_source(renderer: ScenarioRenderer, tmp_path: Path) -> None:
+    scenario = Scenario("drive", "", (Segment(1.2),), 35.0, ())
+    track = renderer.write_side_files(scenario, tmp_path)
+    assert track == tmp_path / "drive.speed.csv" and (tmp_path / "drive.truth.csv").is_file()
+    speed = read_speed_track(track)
+    assert speed.kmh_at(0.0) == 35.0 and speed.kmh_at(1.2) == 35.0
+    clip = tmp_path / "drive.mkv"
+    frames = list(RenderedSource(renderer, scenario, clip))
+    assert [f.t_s for f in frames] == pytest.approx([0.0, 0.2, 0.4, 0.6, 0.8, 1.0])
+    assert clip.stat().st_size > 0
+    assert (
+        renderer.write_side_files(Scenario("drive", "", (Segment(1.0),), None, ()), tmp_path)
+        is None
+    )
+    assert not track.exists()  # no speed: no track (unknown)
+
+
+def test_eyes_at_rest_turn_with_the_head_as_an_eyeball(renderer: ScenarioRenderer) -> None:
+    """Ahead, the frame is the plain render; pitched up, only the irises move (the flat iris of
+    the photo would read as eyes looking down)."""
+    eyes = renderer.renderer
+    assert np.array_equal(eyes.render_eyes(0.0, 0.0, EyeState()), eyes.render(0.0, 0.0))
+    moved = np.abs(grey(eyes.render_eyes(0.0, 20.0, EyeState())) - grey(eyes.render(0.0, 20.0)))
+    assert 0.0 < (moved > 20).mean() < 0.01
+    eyes.eyeball_at_rest = False
+    try:
+        assert np.array_equal(eyes.render_eyes(0.0, 20.0, EyeState()), eyes.render(0.0, 20.0))
+    finally:
+        eyes.eyeball_at_rest = True

@@ -63,7 +63,7 @@ def test_group_figures_are_weighted_by_frames_and_time() -> None:
     assert alice.face_found_rate == pytest.approx((1800 + 450) / 2700)
     assert alice.off_road_ratio == pytest.approx((180 + 300) / (1800 + 600))
     eye_kinds = ("microsleep", "sleep", "drowsy", "unresponsive", "degraded")
-    eye_kinds += ("temporary_failure", "permanent_failure")  # alert/3: counted, none here
+    eye_kinds += ("temporary_failure", "permanent_failure")  # alert/3's failure kinds
     assert alice.alerts == {
         "long_distraction": 3,
         "vats": 1,

@@ -116,7 +116,8 @@ class FrameCheck:
     saturated_fraction: float
     """Fraction of the sampled pixels at 250 or more."""
     diff_grey: float | None
-    """Mean absolute grey difference from the previous frame; None for the first."""
+    """Largest absolute grey difference of a sample from the previous frame's; None for the
+    first."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -189,7 +190,8 @@ class Alert:
     level: AlertLevel
     t_s: float
     yaw_deg: float | None
-    """Yaw relative to the camera (not to neutral) at the event; None without a face."""
+    """Head yaw at the event in the driver's frame (the camera's, with the camera in front: see
+    `[monitor] camera_mounting`), not relative to the neutral; None without a face."""
     off_road_s: float
     """Length of the current continuous off-road episode (for `cleared`: of the one just ended)."""
     window_off_road_s: float
@@ -224,9 +226,10 @@ class Verdict:
     on_road: bool | None
     """Road ahead; None when the gaze is unknown (no face, not explained by a turn away)."""
     yaw_deg: float | None
-    """The yaw judged (smoothed, else raw); None without a face or a usable yaw."""
+    """The yaw judged (smoothed, else raw) in the driver's frame (the camera mounting applied;
+    the camera's with the camera in front); None without a face or a usable yaw."""
     neutral_yaw_deg: float
-    """The road-ahead yaw the monitor measures against (fixed or learned)."""
+    """The road-ahead yaw the monitor measures against (fixed or learned), driver's frame."""
     off_road_s: float
     """Length of the current counted (off road and moving) episode."""
     window_off_road_s: float

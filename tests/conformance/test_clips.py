@@ -23,7 +23,7 @@ FPS = 5.0
 def renderer() -> ScenarioRenderer:
     from roadgaze.synth import EyeRenderer, load_photo
 
-    return ScenarioRenderer(EyeRenderer(load_photo(), (160, 160)), FPS)
+    return ScenarioRenderer(EyeRenderer(load_photo(), (160, 160), eyeball_at_rest=True), FPS)
 
 
 def grey(frame: Any) -> Any:
@@ -85,3 +85,17 @@ def test_side_files_and_the_source(renderer: ScenarioRenderer, tmp_path: Path) -
         is None
     )
     assert not track.exists()  # no speed: no track (unknown)
+
+
+def test_eyes_at_rest_turn_with_the_head_as_an_eyeball(renderer: ScenarioRenderer) -> None:
+    """Ahead, the frame is the plain render; pitched up, only the irises move (the flat iris of
+    the photo would read as eyes looking down)."""
+    eyes = renderer.renderer
+    assert np.array_equal(eyes.render_eyes(0.0, 0.0, EyeState()), eyes.render(0.0, 0.0))
+    moved = np.abs(grey(eyes.render_eyes(0.0, 20.0, EyeState())) - grey(eyes.render(0.0, 20.0)))
+    assert 0.0 < (moved > 20).mean() < 0.01
+    eyes.eyeball_at_rest = False
+    try:
+        assert np.array_equal(eyes.render_eyes(0.0, 20.0, EyeState()), eyes.render(0.0, 20.0))
+    finally:
+        eyes.eyeball_at_rest = True

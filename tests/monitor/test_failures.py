@@ -37,7 +37,7 @@ def test_check_frame_closed_forms() -> None:
     brighter = image.copy()
     brighter[::FRAME_STRIDE, ::FRAME_STRIDE][30:, :, 1] = 110
     moved, _ = check_frame(brighter, grey)
-    assert moved.diff_grey == pytest.approx(5.0)  # half the samples 10 grey levels brighter
+    assert moved.diff_grey == pytest.approx(10.0)  # half the samples 10 grey levels brighter
 
 
 @pytest.mark.parametrize(
@@ -166,3 +166,19 @@ def test_a_permanent_failure_sets_the_vss_error_signal() -> None:
         ("Vehicle/ADAS/DMS/IsError", b"false"),
         ("Vehicle/ADAS/DMS/IsWarning", b"false"),
     ]
+
+
+def test_the_pipeline_checks_every_frame_a_repeated_frame_is_frozen() -> None:
+    """Through the loop: 11 s of one blank frame with a face read as road (at 30 fps)."""
+    from fakes import ListSource, ScriptedDetector
+    from roadgaze.pipeline import Pipeline
+    from test_pipeline_synthetic import Collect
+
+    collect = Collect()
+    Pipeline.from_config(Config(), ScriptedDetector([0.0] * 330)).run(ListSource(330), [collect])
+    failures = [
+        a for r in collect.records for a in r.alerts if a.kind is AlertKind.TEMPORARY_FAILURE
+    ]
+    assert len(failures) == 1  # the scripted face has no eyes either: that one came first
+    assert [r.sample.frame_check is not None for r in collect.records] == [True] * 330
+    assert collect.records[-1].verdict.failure == "frames frozen 10.9 s"

@@ -91,7 +91,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
     out_dir: Path = args.out
     if out_dir.is_file():
         raise ConfigError(f"--out {out_dir} is a file; pass a folder")
-    renderer = ScenarioRenderer(EyeRenderer(load_photo(), SIZE, config=config), FPS)
+    eyes = EyeRenderer(load_photo(), SIZE, config=config, eyeball_at_rest=True)
+    renderer = ScenarioRenderer(eyes, FPS, config.monitor.cabin)
 
     def progress(scenario: Any, outcomes: list[Any]) -> None:
         verdict = "PASS" if all(o.passed for o in outcomes) else "FAIL"

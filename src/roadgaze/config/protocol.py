@@ -75,9 +75,9 @@ class ProtocolSettings(Section):
     """A frame with less grey-level spread than this is blocked (covered lens, flat image)."""
     frame_saturated_fraction: float = Field(default=0.6, gt=0, le=1)
     """A frame with more than this fraction of pixels at 250 or more is saturated (blinded)."""
-    frozen_max_diff: float = Field(default=0.2, ge=0)
-    """A frame whose mean absolute grey difference from the previous one is at most this is a
-    repeat (frozen)."""
+    frozen_max_diff: float = Field(default=0.5, ge=0)
+    """A frame none of whose grey samples differs from the previous frame's by more than this
+    is a repeat (frozen)."""
 
     @model_validator(mode="after")
     def _bands_agree(self) -> ProtocolSettings:

@@ -22,7 +22,7 @@ import numpy as np
 
 from roadgaze.capture.base import SourceBase, SourceInfo, SourceStatus
 from roadgaze.conformance.model import CameraState, Scenario
-from roadgaze.pose.mounting import head_to_camera, mounting_for
+from roadgaze.pose.mounting import Cabin, head_to_camera, mounting_for
 from roadgaze.synth.clip import write_truth_csv
 from roadgaze.synth.effects import NoiseBank, covered_frame, sunglasses
 from roadgaze.synth.eyes import EyeRenderer, EyeState
@@ -62,10 +62,11 @@ def write_speed_track(path: Path, speed_kmh: float, duration_s: float) -> None:
 
 
 class ScenarioRenderer:
-    """Renders scenarios with one `EyeRenderer` (built once: it runs MediaPipe on the photo);
-    identical poses are rendered once per scenario."""
+    """Renders scenarios with one `EyeRenderer` (built once: it runs MediaPipe on the photo; give
+    it `eyeball_at_rest=True`, so eyes at rest turn with the head as an eyeball does); identical
+    poses are rendered once per scenario."""
 
-    def __init__(self, renderer: EyeRenderer, fps: float, cabin: str = "lhd") -> None:
+    def __init__(self, renderer: EyeRenderer, fps: float, cabin: Cabin = "lhd") -> None:
         self.renderer = renderer
         self.fps = fps
         self.cabin = cabin
@@ -73,7 +74,7 @@ class ScenarioRenderer:
     def _face(
         self, scenario: Scenario, row: FloatArray, cache: dict[tuple[float, ...], ImageBGR]
     ) -> ImageBGR:
-        mounting = mounting_for(scenario.mounting, self.cabin)  # type: ignore[arg-type]
+        mounting = mounting_for(scenario.mounting, self.cabin)
         yaw, pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
         key = tuple(round(float(v), 4) for v in (yaw, pitch, *row[3:6]))
         if key not in cache:
@@ -140,7 +141,8 @@ class RenderedSource(SourceBase):
 
         writer: Any = None
         if self._clip is not None:
-            writer = open_video_writer(self._clip, self._renderer.fps, self._info_size, "FFV1")
+            size = (self._info.width, self._info.height)
+            writer = open_video_writer(self._clip, self._renderer.fps, size, "FFV1")
         try:
             for index, image in enumerate(self._renderer.frames(self._scenario)):
                 if writer is not None:
@@ -150,10 +152,6 @@ class RenderedSource(SourceBase):
         finally:
             if writer is not None:
                 writer.release()
-
-    @property
-    def _info_size(self) -> tuple[int, int]:
-        return self._info.width, self._info.height
 
     def close(self) -> None:
         return None

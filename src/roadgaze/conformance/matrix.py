@@ -30,7 +30,8 @@ the photo holds up to about this)."""
 BEYOND_AREA_DEG = 15.0
 """A look into ADDW's area 1 goes this far past its edge (55 + 15 = 70 deg: a side window)."""
 SHOULDER_YAW_DEG = 80.0
-"""Over the (left) shoulder: as far as the renderer turns a face."""
+"""Over the outer shoulder (the left one in a left-hand-drive cabin): as far as the renderer
+turns a face."""
 VATS_GLANCE_S, VATS_ROAD_S = 2.2, 1.2
 """Glances at the centre stack for VATS: each below the long-distraction trigger."""
 EYES_LAP_DEG = (-10.0, -35.0)
@@ -109,6 +110,7 @@ def distraction_scenarios(config: MonitorConfig) -> list[Scenario]:
     far = config.distraction_yaw_deg + BEYOND_AREA_DEG
     roof = (0.0, min(config.roof_pitch_deg + 12.0, PITCH_LIMITS_DEG[1]))
     fast_kmh_text = f"{FAST_KMH:g} km/h"
+    outer = "left" if config.cabin == "lhd" else "right"
     scenarios = [
         _glance(config, "lap_70", f"4 s lap glance at {fast_kmh_text}", lap, FAST_KMH, fast=True),
         _glance(
@@ -148,8 +150,8 @@ def distraction_scenarios(config: MonitorConfig) -> list[Scenario]:
         _glance(
             config,
             "shoulder_70",
-            f"4 s look over the left shoulder at {fast_kmh_text}",
-            (SHOULDER_YAW_DEG, 0.0),
+            f"4 s look over the {outer} shoulder at {fast_kmh_text}",
+            (SHOULDER_YAW_DEG if outer == "left" else -SHOULDER_YAW_DEG, 0.0),
             FAST_KMH,
         ),
         _glance(config, "roof_70", f"4 s look at the roof at {fast_kmh_text}", roof, FAST_KMH),
@@ -173,7 +175,10 @@ def distraction_scenarios(config: MonitorConfig) -> list[Scenario]:
             fast=True,
         )
     )
-    mirror_source = f"mirrors are driving-related ({expect.source_of(addw.AREA_YAW)})"
+    mirror_source = (
+        "mirror glances are driving-related (driving_related_zones); distraction area 1 starts "
+        f"beyond them: {expect.source_of(addw.AREA_YAW)}"
+    )
     for side, fast in (("left", True), ("right", False)):
         target = zone_target(config, f"{side}_mirror")
         text = f"1.5 s {side} mirror glance at {fast_kmh_text}: no warning"

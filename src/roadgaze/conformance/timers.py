@@ -145,20 +145,32 @@ def camera_scenarios(config: MonitorConfig) -> list[Scenario]:
     """A covered lens, frozen frames, the driver out of view."""
     failure = ("temporary_failure",)
     covered = expect.timer(
-        config, addw.FAILURE_TEMPORARY, failure, "covered_70.fails", "lens covered 5 s at 70 km/h"
+        config,
+        addw.FAILURE_TEMPORARY,
+        failure,
+        "covered_70.fails",
+        "lens covered 5 s at 70 km/h: temporary failure",
     )
     frozen = expect.timer(
-        config, own_rules.FROZEN, failure, "frozen_70.fails", "frames frozen 13 s at 70 km/h"
+        config,
+        own_rules.FROZEN,
+        failure,
+        "frozen_70.fails",
+        "frames frozen 13 s at 70 km/h: temporary failure",
     )
     gone = expect.timer(
         config,
         own_rules.UNAVAILABLE,
         ("driver_unavailable",),
         "no_face_70.unavailable",
-        "no face 13 s at 70 km/h",
+        "no face 13 s at 70 km/h: driver unavailable",
     )
     gone_failure = expect.timer(
-        config, own_rules.NO_FACE, failure, "no_face_70.fails", "no face 13 s at 70 km/h"
+        config,
+        own_rules.NO_FACE,
+        failure,
+        "no_face_70.fails",
+        "no face 13 s at 70 km/h: temporary failure",
     )
     return [
         Scenario(

@@ -1,17 +1,18 @@
 """Failure warnings: what tells a failed camera from a driver. Pure (numpy only).
 
 `check_frame` measures one image cheaply: the green channel (most of luma) of every
-`FRAME_STRIDE`-th pixel in each direction (4,800 pixels of a 640x480 frame: 0.016 ms median,
-0.063 ms mean on this shared 2-core machine by `scripts/bench-frame-check.py`), its mean, spread,
-saturated fraction and mean absolute difference from the previous frame's sample.
+`FRAME_STRIDE`-th pixel in each direction (4,800 pixels of a 640x480 frame: 0.033 ms of CPU per
+frame on a shared 2-core machine, `scripts/bench-frame-check.py`), its mean, spread,
+saturated fraction and largest absolute difference from the previous frame's samples.
 `step_failures` turns those checks and the face into a temporary failure (EU 2023/2590 Annex I
 3.5.2; docs/monitor.md, "Failures"), each timed while the vehicle moves:
 
 - frames black (mean grey below `frame_dark_mean`), blocked (spread below `frame_min_std`: a
   covered lens) or saturated (more than `frame_saturated_fraction` at 250 or more: blinded), with
   no judgeable face, for `frame_failure_s` (a dark image that still shows a face is working);
-- frames frozen (differing from the previous one by at most `frozen_max_diff` grey levels) for
-  `frozen_failure_s`;
+- frames frozen (no sample differing from the previous frame's by more than `frozen_max_diff`
+  grey levels: a repeated frame; a live camera's noise changes some sample every frame, and a
+  rendered face whose eyes alone move is not frozen) for `frozen_failure_s`;
 - no judgeable face (none, or one whose yaw the model cannot explain) for `no_face_failure_s`;
 - the eyes unjudgeable (`degraded`) while a Euro NCAP rule needs them.
 
@@ -50,7 +51,7 @@ def check_frame(
     variance = max(0.0, float(np.dot(flat, flat)) / count - mean * mean)
     diff = None
     if previous is not None and previous.shape == grey.shape:
-        diff = float(np.abs(grey - previous).sum()) / count
+        diff = float(np.abs(grey - previous).max())
     check = FrameCheck(
         mean_grey=mean,
         std_grey=variance**0.5,

@@ -21,26 +21,33 @@ Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monit
   `unavailable_s`, the driver is `driver_unavailable`; while the image works (no black, blocked
   or saturated frame) that unknown time also runs the long-distraction timer: a driver not seen
   is not seen on the road.
-- `long_distraction`: the current off-road episode has spent `long_distraction_s` outside the
-  driving-related zones (`driving_related_zones`, the mirrors: their time pauses the timer, up to
-  `driving_glance_max_s` per continuous stay when that is set); level warning, raised to
-  critical at `critical_distraction_s`.
-- `vats`: off-road time (every zone but road) within the last `vats_window_s` reaches
-  `vats_threshold_s`; fires once and is re-armed after `vats_rearm_s` continuously on road.
+- frames: the sample's yaw and pitch are mapped from the camera's frame into the driver's
+  (`camera_mounting`, `cabin`: roadgaze.pose.mounting) before anything else.
+- `long_distraction`: the current off-road episode has spent the protocol's distraction time
+  (`roadgaze.monitor.protocols`: the earliest of the configured protocols' at this speed) outside
+  the driving-related zones (`driving_related_zones`, the mirrors: their time pauses the timer, up
+  to `driving_glance_max_s` per continuous stay when that is set; ADDW's area 1 never is); level
+  warning, raised to critical `critical_after_warning_s` later (not before
+  `critical_distraction_s`).
+- `temporary_failure` (roadgaze.monitor.failures): blocked, black, saturated or frozen frames,
+  no judgeable face, unjudgeable eyes, each for its time while moving; cleared once recovered.
+- `vats` (Euro NCAP only): off-road time (every zone but road) within the last `vats_window_s`
+  reaches `vats_threshold_s`; fires once and is re-armed after `vats_rearm_s` continuously on
+  road.
 - eyes (`roadgaze.monitor.eyes`): open, closed or unavailable per sample; with the eyes open and
   giving a direction the zone is judged on the gaze (head + eyes beyond `gaze_deadband_deg`)
   against a road `eyes_road_margin_deg` narrower, so an eyes-only glance counts; otherwise
   (eyes closed or unavailable) on the head pose. Closures raise `microsleep`, `sleep` and
   `unresponsive`; PERCLOS and long blinks `drowsy`; eyes unavailable `degraded`.
-- `unresponsive` on the distraction path: away (outside the road and driving-related zones)
-  `unresponsive_away_s`, or not back on the road `unresponsive_after_warning_s` after a
-  `long_distraction` or `vats` warning.
-- `cleared`: the first on-road sample with a face and eyes not closed after any distraction
-  alert; a closure's alerts once the eyes are open on the road again; `drowsy` once re-armed;
-  `degraded` once the eyes are back.
-- speed gating: time off road or unavailable counts only while the vehicle moves faster than
-  `min_speed_kmh` (`speed_kmh` None means unknown and is taken as moving), so no alert fires
-  below that speed.
+- `unresponsive` on the distraction path (Euro NCAP only): away (outside the road and
+  driving-related zones) `unresponsive_away_s`, or not back on the road
+  `unresponsive_after_warning_s` after a `long_distraction` or `vats` warning.
+- `cleared`: on the road with a face and eyes not closed for `clear_on_road_s` after any
+  distraction alert; a closure's alerts once the eyes are open on the road again; `drowsy` once
+  re-armed; `degraded` once the eyes are back.
+- speed gating: time off road or unavailable counts only while a configured protocol is active
+  (ADDW above `addw_min_speed_kmh`, Euro NCAP above `min_speed_kmh`; `speed_kmh` None means
+  unknown and is taken as moving, in the highest band), so no alert fires below that speed.
 
 Time accounting is sample-based: an off-road episode starts at the first off-road sample and its
 duration at a later sample is the difference of their timestamps, so each alert fires on the

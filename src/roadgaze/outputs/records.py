@@ -99,6 +99,8 @@ ALERT_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("closure_s", FieldType.FLOAT),
     ("perclos", FieldType.FLOAT),
     ("reason", FieldType.STR),
+    ("rule", FieldType.STR),
+    ("source", FieldType.STR),
 )
 """Every field of `alert_fields`: the content of an `AlertMessage` without its wire fields."""
 
@@ -114,6 +116,7 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
     """The per-frame record as a JSON-ready dict; None (null) where there is no value."""
     sample, verdict = record.sample, record.verdict
     features = sample.features
+    neutral = verdict.camera_neutral_deg or (verdict.neutral_yaw_deg, verdict.neutral_pitch_deg)
     return {
         "t_s": round(sample.t_s, 6),
         "frame": sample.frame,
@@ -134,8 +137,9 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "gaze": verdict.gaze.value,
         "zone": verdict.zone,
         "eyes_on_road": verdict.eyes_on_road,
-        "neutral_yaw_deg": round(verdict.neutral_yaw_deg, 3),
-        "neutral_pitch_deg": round(verdict.neutral_pitch_deg, 3),
+        # The neutral in the frame of `yaw_deg` (the camera's; docs/monitor.md, Camera mounting).
+        "neutral_yaw_deg": round(neutral[0], 3),
+        "neutral_pitch_deg": round(neutral[1], 3),
         "off_road_s": round(verdict.off_road_s, 3),
         "window_off_road_s": round(verdict.window_off_road_s, 3),
         "distraction_s": round(verdict.distraction_s, 3),
@@ -161,6 +165,8 @@ def alert_fields(alert: Alert) -> dict[str, Any]:
         "closure_s": round(max(0.0, alert.closure_s), 3),
         "perclos": rounded(alert.perclos, 4),
         "reason": alert.reason,
+        "rule": alert.rule,
+        "source": alert.source,
     }
 
 

@@ -138,7 +138,11 @@ class EyeRenderer(FaceRenderer):
 
     `lid_follow`: how far the upper lid follows downward gaze (0 not at all, 1 as far as the iris
     centre moves). `render(yaw, pitch)` is unchanged, and `render_eyes` with `EyeState()` gives the
-    same frame.
+    same frame, unless `eyeball_at_rest`: then the iris of eyes at rest is drawn by the eyeball
+    model too whenever the head is turned or pitched. The photo's own iris lies flat in the eye
+    opening (the mesh closes the opening with a flat strip), so with the head pitched up 20 deg
+    MediaPipe reads eyes at rest as looking 14 deg down; the eyeball model puts the iris `b W` in
+    front of the corners, where a turned head shows it (the conformance drives use it).
     """
 
     def __init__(
@@ -148,11 +152,13 @@ class EyeRenderer(FaceRenderer):
         landmarks_px: FloatArray | None = None,
         config: Config | None = None,
         lid_follow: float = 1.0,
+        eyeball_at_rest: bool = False,
     ) -> None:
         super().__init__(photo_bgr, size, landmarks_px, config)
         self.k = EYEBALL.k
         self.b = EYEBALL.b
         self.lid_follow = lid_follow
+        self.eyeball_at_rest = eyeball_at_rest
         self.base_texture: ImageBGR = np.asarray(self.texture, dtype=np.uint8)
         self._patches = {eye.side: self._eye_patch(eye) for eye in EYES}
 
@@ -342,13 +348,14 @@ class EyeRenderer(FaceRenderer):
 
     def eye_texture(self, yaw_deg: float, pitch_deg: float, state: EyeState) -> ImageBGR:
         """The photo texture with both eyes drawn as `state` says, for this head pose."""
-        if state.at_rest:
+        head_moved = self.eyeball_at_rest and (yaw_deg != 0.0 or pitch_deg != 0.0)
+        if state.at_rest and not head_moved:
             return self.base_texture
         texture = self.base_texture.copy()
         for eye, openness in ((EYES[0], state.openness_right), (EYES[1], state.openness_left)):
             patch = self._patches[eye.side]
             region = patch.original
-            if state.eye_yaw_deg != 0.0 or state.eye_pitch_deg != 0.0:
+            if head_moved or state.eye_yaw_deg != 0.0 or state.eye_pitch_deg != 0.0:
                 centre, to_disc = self.iris_placement(eye, yaw_deg, pitch_deg, state)
                 region = self._draw_iris(patch, centre, to_disc)
             drop_px = max(

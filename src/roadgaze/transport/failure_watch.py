@@ -10,6 +10,7 @@ alert). `model_failure` raises one for a model that cannot be loaded, before the
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from collections.abc import Callable
@@ -19,6 +20,8 @@ from roadgaze.transport.health import Health
 from roadgaze.types import Alert, AlertKind, AlertLevel
 
 __all__ = ["PermanentFailureWatch", "failure_alert"]
+
+log = logging.getLogger("roadgaze.daemon")
 
 
 def failure_alert(t_s: float, reason: str, clears: bool = False) -> Alert:
@@ -87,9 +90,12 @@ class PermanentFailureWatch:
 
     def _run(self) -> None:
         while not self._stop.wait(self.interval_s):
-            alert = self.check()
-            if alert is not None:
-                self.publish(alert)
+            try:
+                alert = self.check()
+                if alert is not None:
+                    self.publish(alert)
+            except Exception as exc:  # a safety warning must not die silently: say so, go on
+                log.warning("permanent failure watch: %s", exc)
 
     def start(self) -> PermanentFailureWatch:
         """Start watching (a daemon thread); `close` stops it."""

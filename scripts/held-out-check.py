@@ -1,7 +1,7 @@
 """The issue-21 acceptance check on every Pointing'04 development subject (real faces).
 
 Usage: PYTHONPATH=src python scripts/held-out-check.py [DATASET] [--subjects 1,2] [--series 1,2]
-       [--cases NAME,...] [--jobs N]
+       [--cases NAME,...] [--jobs N] [--set SECTION.FIELD=VALUE ...]
 
 Builds, for each subject, series and case of `roadgaze.evaluation.held_out.CASES`, a 15 fps clip
 (frontal still, the look's still held, frontal again), runs it through the pipeline at the case's
@@ -17,13 +17,14 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from roadgaze.config import Config, load_config
 from roadgaze.evaluation.held_out import CASES, Case, CaseResult, Stills, load_stills, run_case
 from roadgaze.logs import setup_logging
 
 DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "pointing04-dev"
 
 
-def _run(job: tuple[Stills, Case]) -> CaseResult:
+def _run(job: tuple[Stills, Case, Config]) -> CaseResult:
     setup_logging()
     return run_case(*job)
 
@@ -39,6 +40,13 @@ def main() -> int:
     parser.add_argument("--series", default="1", help="comma-separated series (default: 1)")
     parser.add_argument("--cases", help="comma-separated case names (default: all)")
     parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="SECTION.FIELD=VALUE",
+        help="override one configuration value, e.g. monitor.protocol=addw",
+    )
     args = parser.parse_args()
     subjects, series = _numbers(args.subjects), _numbers(args.series)
     cases = [c for c in CASES if args.cases is None or c.name in args.cases.split(",")]
@@ -47,7 +55,8 @@ def main() -> int:
         for s in load_stills(args.dataset)
         if (subjects is None or s.subject in subjects) and (series is None or s.series in series)
     ]
-    jobs = [(stills, case) for stills in all_stills for case in cases]
+    config = load_config(overrides=dict(item.split("=", 1) for item in args.set))
+    jobs = [(stills, case, config) for stills in all_stills for case in cases]
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         results = list(pool.map(_run, jobs))
     for r in results:

@@ -402,26 +402,29 @@ LAP = (0.0, -35.0)
 
 
 def test_a_mirror_glance_is_off_road_but_raises_no_long_distraction() -> None:
+    """(A glance of 3.5 s before the default `driving_glance_max_s` went from 4 s to 2 s.)"""
     _, alerts, zones = run_poses(
-        segments((1.0, ROAD_POSE), (3.5, LEFT_MIRROR), (2.0, ROAD_POSE)), 6.5
+        segments((1.0, ROAD_POSE), (1.9, LEFT_MIRROR), (1.5, AWAY_POSE), (2.0, ROAD_POSE)), 6.4
     )
     assert alerts == []
-    assert zones[60] == "left_mirror" and zones[-1] == "road"
+    assert zones[40] == "left_mirror" and zones[-1] == "road"
     inside = Monitor(FIXED)
-    for frame in range(round(4.0 * FPS)):
+    for frame in range(round(2.9 * FPS)):
         inside.update(sample(frame / FPS, 0.0 if frame < 30 else 45.0, frame, 0.0))
     verdict = inside.verdict
     assert (verdict.zone, verdict.on_road, verdict.gaze) == ("left_mirror", False, Gaze.OFF_ROAD)
-    assert verdict.off_road_s == pytest.approx(3.0 - FRAME_S, abs=1e-6)
-    assert verdict.window_off_road_s == pytest.approx(3.0 - FRAME_S, abs=1e-6)
+    assert verdict.off_road_s == pytest.approx(1.9 - FRAME_S, abs=1e-6)
+    assert verdict.window_off_road_s == pytest.approx(1.9 - FRAME_S, abs=1e-6)
     assert verdict.distraction_s == 0.0
 
 
 def test_a_mirror_stare_of_the_default_limit_is_a_long_distraction() -> None:
-    """Fail-safe default: 4 s in a mirror zone is a stare (or a look out of the side window)."""
+    """Fail-safe default: 2 s in a mirror zone is a stare (or a look out of the side window read
+    short: a real 60 deg look reads 47-52 deg on 4 of 10 Pointing'04 subjects); it counts from
+    its start, so the warning comes when a look elsewhere would (before: 4 s, at 5 s)."""
     _, alerts, _ = run_poses(segments((1.0, ROAD_POSE), (8.0, LEFT_MIRROR), (2.0, ROAD_POSE)), 11.0)
     assert kinds(alerts)[0] == ("long_distraction", "warning")
-    assert_within_one_frame(alerts[0].t_s, 1.0 + 4.0)
+    assert_within_one_frame(alerts[0].t_s, 1.0 + 3.0)
     excused = FIXED.model_copy(update={"driving_glance_max_s": None})
     _, none_raised, _ = run_poses(
         segments((1.0, ROAD_POSE), (8.0, LEFT_MIRROR), (2.0, ROAD_POSE)), 11.0, excused
@@ -443,8 +446,8 @@ def test_mirror_glances_count_for_vats() -> None:
     [
         # mirror 1 s, then away: the timer starts with the away part and fires 3 s into it
         (((1.0, ROAD_POSE), (1.0, LEFT_MIRROR), (5.0, AWAY_POSE)), 1.0 + 1.0 + 3.0),
-        # away 2 s, mirror 2 s (pauses, does not reset), away again: 1 s more
-        (((1.0, ROAD_POSE), (2.0, AWAY_POSE), (2.0, LEFT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 5.0),
+        # away 2 s, mirror 1.5 s (pauses, does not reset), away again: 1 s more
+        (((1.0, ROAD_POSE), (2.0, AWAY_POSE), (1.5, LEFT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 4.5),
         # mirror 1.5 s then away 2 s: 2 s of distraction, no alert
         (((1.0, ROAD_POSE), (1.5, LEFT_MIRROR), (2.0, AWAY_POSE), (2.0, ROAD_POSE)), None),
         # the lap is not driving-related

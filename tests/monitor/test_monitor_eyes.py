@@ -71,7 +71,7 @@ def near(t_s: float, expected_s: float) -> bool:
     [
         (-30.0, -25.0, "centre_stack"),  # gaze -20/-15
         (-32.0, 0.0, "away"),  # gaze -22: beyond the narrower road's -20
-        (32.0, 0.0, "left_mirror"),  # gaze 22 (driving-related: no long distraction)
+        (32.0, 0.0, "left_mirror"),  # gaze 22: driving-related, but 4 s there is a stare
         (0.0, -32.0, "lap"),  # gaze pitch -22
         (0.0, -24.0, "cluster"),  # gaze pitch -14: below the narrower road's -10
     ],
@@ -79,12 +79,10 @@ def near(t_s: float, expected_s: float) -> bool:
 def test_an_eyes_only_glance_is_off_road(eye_yaw: float, eye_pitch: float, zone: str) -> None:
     glance = eyes_of(eye_yaw=eye_yaw, eye_pitch=eye_pitch)
     _, alerts = run(between(2.0, 6.0, glance), 8.0)
-    if zone == "left_mirror":
-        assert alerts == []
-    else:
-        assert kinds(alerts) == ["long_distraction:warning", "cleared:info"]
-        assert near(alerts[0].t_s, 5.0) and near(alerts[1].t_s, 6.0)
-        assert alerts[0].reason == f"eyes in {zone}"  # the head stayed ahead: say so
+    # (A 4 s stay in a mirror zone raised nothing while driving_glance_max_s was 4 s; it is 2 s.)
+    assert kinds(alerts) == ["long_distraction:warning", "cleared:info"]
+    assert near(alerts[0].t_s, 5.0) and near(alerts[1].t_s, 6.0)
+    assert alerts[0].reason == f"eyes in {zone}"  # the head stayed ahead: say so
     _, during = run(between(2.0, 6.0, glance), 4.0)
     assert during == []
     probe = Monitor(FIXED)

@@ -179,7 +179,7 @@ class MonitorConfig(EyeMonitorSettings, ProtocolSettings):
     )
     """Zones whose time counts as off road (VATS, eyes_on_road) but does not run the
     long-distraction timer."""
-    driving_glance_max_s: float | None = Field(default=4.0, gt=0)
+    driving_glance_max_s: float | None = Field(default=2.0, gt=0)
     """A continuous stay in a driving-related zone this long is a stare, not a glance: it counts as
     distraction from its start (fail-safe: a long look out of the side window is not excused as a
     mirror check); None: never."""

@@ -18,7 +18,9 @@ Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monit
 - face lost: while the head was off road (or, with `turn_away_deg` set, past that yaw), the
   driver is taken as still turned away, i.e. off road (zone: the last zone, `away` if that was
   driving-related); otherwise where they look is unknown (zone None) and, after
-  `unavailable_s`, the driver is `driver_unavailable`.
+  `unavailable_s`, the driver is `driver_unavailable`; while the image works (no black, blocked
+  or saturated frame) that unknown time also runs the long-distraction timer: a driver not seen
+  is not seen on the road.
 - frames: the sample's yaw and pitch are mapped from the camera's frame into the driver's
   (`camera_mounting`, `cabin`: roadgaze.pose.mounting) before anything else.
 - `long_distraction`: the current off-road episode has spent the protocol's distraction time
@@ -140,8 +142,12 @@ def step(
     trigger = distraction_trigger(config, speed_kmh, non_nominal) if moving else None
     ncap = uses(config, "euroncap")
 
-    # Continuous off-road episode, its distraction time and the VATS window (while moving).
-    counted_off = gaze is Gaze.OFF_ROAD and moving
+    # Continuous off-road episode, its distraction time and the VATS window (while moving). A
+    # face lost while the image works is not seen on the road: its time counts too (fail-safe: a
+    # still cut from ahead to a profile the landmarker cannot find is a look away; a failed camera
+    # is a temporary failure instead).
+    unseen = gaze is Gaze.UNKNOWN and not frame_issue(config, sample.frame_check)
+    counted_off = (gaze is Gaze.OFF_ROAD or unseen) and moving
     driving = zones.is_driving_related(look.zone)
     off_since = state.off_since_s
     segment_since, segment_driving = state.segment_since_s, state.segment_driving
@@ -275,7 +281,13 @@ def step(
             active.append(raised.kind)
 
     neutral_yaw, neutral_pitch, yaw_learned_s, pitch_learned_s = learn_neutral(
-        config, state, look.yaw_deg, look.pitch_deg, t_s, sample.yaw_rate_dps
+        config,
+        state,
+        look.yaw_deg,
+        look.pitch_deg,
+        t_s,
+        sample.yaw_rate_dps,
+        judged_on_road=look.zone == ROAD,
     )
     new_state = replace(
         state,

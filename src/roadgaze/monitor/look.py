@@ -63,6 +63,8 @@ class Look:
         """Why the driver counts as off road, for the alert's `reason`."""
         if self.turned_away:
             return f"face out of view, last seen in {self.zone}"
+        if self.gaze is Gaze.UNKNOWN:
+            return "face out of view"
         return f"{'eyes' if self.by_eyes else 'head'} in {self.zone}"
 
 

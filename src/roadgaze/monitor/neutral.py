@@ -11,6 +11,8 @@ __all__ = ["learn_neutral"]
 
 _MAX_LEARNING_STEP_S = 1.0
 """A longer gap between samples teaches the neutral pose no more than one second would."""
+SETTLE_S = 1.0
+"""For its first second of learning the neutral also learns from samples judged off the road."""
 
 
 def _learn(value: float, neutral: float, gain: float, limit: float) -> float:
@@ -24,6 +26,7 @@ def learn_neutral(
     pitch_deg: float | None,
     t_s: float,
     yaw_rate_dps: float | None = None,
+    judged_on_road: bool = True,
 ) -> tuple[float, float, float, float]:
     """The neutral yaw and pitch after this sample and the time each has learned from.
 
@@ -36,7 +39,11 @@ def learn_neutral(
     after the glance until the glance reads as road (fail-safe: an alert is never learned
     away). Nor does a head turning faster than `neutral_max_rate_dps` (`yaw_rate_dps`, None:
     unknown) teach: it sweeps through the road on its way elsewhere (a single such sample would
-    otherwise set the neutral at the start of a drive). The gain is the larger of
+    otherwise set the neutral at the start of a drive). Once it has learned `SETTLE_S`, only a
+    sample the monitor judged on the road (`judged_on_road`) teaches: a held glance into the
+    cluster or the lap, level enough to pass the pitch test (a real 30 deg look down reads 10-15 deg), would otherwise walk the neutral pitch
+    after it until the glance reads as road (Pointing'04 subject 8: 4 deg in 2 s, alert lost;
+    scripts/held-out-check.py). The gain is the larger of
     the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
     over the time learned so far): the neutral settles on the driver's road pose within seconds
     of the start and then follows it slowly.
@@ -54,7 +61,8 @@ def learn_neutral(
         or not math.isfinite(yaw_rate_dps)
         or abs(yaw_rate_dps) <= limit
     )
-    if not (ahead and level and steady):
+    settled = max(yaw_s, pitch_s) >= SETTLE_S
+    if not (ahead and level and steady) or (settled and not judged_on_road):
         return yaw, pitch, yaw_s, pitch_s
     dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
     slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)

@@ -41,10 +41,10 @@ def learn_neutral(
     unknown) teach: it sweeps through the road on its way elsewhere (a single such sample would
     otherwise set the neutral at the start of a drive). Once it has learned `SETTLE_S`, only a
     sample the monitor judged on the road (`judged_on_road`) teaches: a held glance into the
-    cluster or the lap, level enough to pass the pitch test (a real 30 deg look down reads 10-15 deg), would otherwise walk the neutral pitch
-    after it until the glance reads as road (Pointing'04 subject 8: 4 deg in 2 s, alert lost;
-    scripts/held-out-check.py). The gain is the larger of
-    the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
+    cluster or the lap, level enough to pass the pitch test (a real 30 deg look down reads 10-15
+    deg), would otherwise walk the neutral pitch after it until the glance reads as road
+    (Pointing'04 subject 8: 4 deg in 2 s, alert lost; scripts/held-out-check.py). The gain is the
+    larger of the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
     over the time learned so far): the neutral settles on the driver's road pose within seconds
     of the start and then follows it slowly.
     """

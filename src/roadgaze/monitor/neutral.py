@@ -44,9 +44,9 @@ def learn_neutral(
     cluster or the lap, level enough to pass the pitch test (a real 30 deg look down reads 10-15
     deg), would otherwise walk the neutral pitch after it until the glance reads as road
     (Pointing'04 subject 8: 4 deg in 2 s, alert lost; scripts/held-out-check.py). The gain is the
-    larger of the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
-    over the time learned so far): the neutral settles on the driver's road pose within seconds
-    of the start and then follows it slowly.
+    larger of the first-order filter's (time constant `neutral_time_constant_s`) and a running
+    mean's (dt over the time learned so far): the neutral settles on the driver's road pose
+    within seconds of the start and then follows it slowly.
     """
     yaw, pitch = state.neutral_yaw_deg, state.neutral_pitch_deg
     yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s

@@ -102,6 +102,10 @@ class LandmarksConfig(_Section):
     mirror_average: bool = False
     """Also run the mirrored image and average the two measurements: exactly mirror-symmetric
     yaw and slightly better accuracy (docs/landmarks.md) for twice the landmarker time."""
+    enhance: Literal["auto", "off", "always"] = "auto"
+    """The front end before the detector (roadgaze.landmarks.front_end): `auto` gives dark or
+    flat frames a contrast curve and looks again with it when no face is found, `off` passes
+    frames as they come, `always` curves every frame (docs/conditions.md)."""
 
 
 class CaptureConfig(_Section):

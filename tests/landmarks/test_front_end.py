@@ -153,3 +153,33 @@ def test_an_enhanced_still_without_a_face_is_looked_at_untouched() -> None:
     assert detector.detect(DARK).driver is None
     assert [image.ndim for _, image in inner.seen] == [2, 3]  # enhanced (grey), then as it came
     np.testing.assert_array_equal(inner.seen[1][1], DARK)
+
+
+@pytest.fixture(scope="module")
+def ir_astronaut() -> np.ndarray:
+    """skimage's astronaut as a flat, noisy near-infrared frame (one grey channel)."""
+    import cv2
+    from skimage import data as skimage_data
+
+    from roadgaze.evaluation.conditions import ir_grey
+
+    bgr = cv2.cvtColor(skimage_data.astronaut(), cv2.COLOR_RGB2BGR)
+    return ir_grey(bgr, np.random.default_rng(0), contrast=0.3, noise_std=8.0)
+
+
+def test_real_mediapipe_finds_an_ir_face_only_through_the_front_end(
+    ir_astronaut: np.ndarray,
+) -> None:
+    from roadgaze.config import Config, ModelConfig
+    from roadgaze.landmarks.landmarker import MediaPipeLandmarker
+    from roadgaze.landmarks.model_store import resolve_model
+
+    model = resolve_model(ModelConfig(), environ={})
+    assert ir_astronaut.ndim == 2
+    with MediaPipeLandmarker(Config().landmarks, model) as landmarker:
+        assert landmarker.detect(ir_astronaut).driver is None
+        still = FrontEndDetector(landmarker).detect(ir_astronaut).driver
+    assert still is not None and 80 < still.x_right_px - still.x_left_px < 110
+    with FrontEndDetector(MediaPipeLandmarker(Config().landmarks, model, video=True)) as stream:
+        found = [stream.detect(ir_astronaut, i / 15).driver is not None for i in range(5)]
+    assert all(found)

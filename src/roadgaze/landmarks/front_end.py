@@ -117,20 +117,22 @@ def _decision_channel(image: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
     )
 
 
-def assess(image: npt.NDArray[np.uint8]) -> FrameLevels:
-    """The level figures of a grey, BGR or BGRA uint8 frame, from its sparse grid and rows (the
-    green channel of a colour frame)."""
+def assess(image: npt.NDArray[np.uint8], noise: bool = False) -> FrameLevels:
+    """The level figures of a grey, BGR or BGRA uint8 frame, from its sparse grid (the green
+    channel of a colour frame); with `noise`, also the noise (the decision does not need it)."""
     channel = _decision_channel(image)
     grid = channel[::GRID_STEP, ::GRID_STEP]
     counts = np.bincount(grid.ravel(), minlength=256).astype(np.float64)
     cumulative = np.cumsum(counts) / max(float(counts.sum()), 1.0)
     p1, p5, p95, p99 = np.searchsorted(cumulative, (0.01, 0.05, 0.95, 0.99))
     mean = float(np.dot(counts, np.arange(256)) / max(float(counts.sum()), 1.0))
-    rows = channel[NOISE_ROW_STEP // 2 :: NOISE_ROW_STEP].astype(np.int16)
-    steps = np.abs(np.diff(rows, axis=1)).ravel()
-    noise = 1.4826 * _median_of_counts(np.bincount(steps, minlength=256)) / np.sqrt(2.0)
+    noise_std = 0.0
+    if noise:
+        rows = channel[NOISE_ROW_STEP // 2 :: NOISE_ROW_STEP].astype(np.int16)
+        steps = np.abs(np.diff(rows, axis=1)).ravel()
+        noise_std = 1.4826 * _median_of_counts(np.bincount(steps, minlength=256)) / np.sqrt(2.0)
     return FrameLevels(
-        mean=mean, spread=float(p95 - p5), low=float(p1), high=float(p99), noise=float(noise)
+        mean=mean, spread=float(p95 - p5), low=float(p1), high=float(p99), noise=noise_std
     )
 
 
@@ -144,18 +146,15 @@ def tone_curve(levels: FrameLevels) -> npt.NDArray[np.uint8]:
     return np.asarray(np.rint(255.0 * ramp**gamma), np.uint8)
 
 
-def enhance(
-    image: npt.NDArray[np.uint8], levels: FrameLevels | None = None
-) -> npt.NDArray[np.uint8]:
+def enhance(image: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
     """`image` as the detector should see it, in one grey channel (a dark frame's colour carries
     little, and one channel costs a third): its luminance, averaged over `SMOOTHING_KERNEL_PX`
-    squares when its noise is `NOISY_LEVELS` or more, through its tone curve. `levels`: those of
-    a grey `image` from `assess` (a colour image's are measured on its luminance here)."""
+    squares when its noise is `NOISY_LEVELS` or more, through its tone curve (the levels and
+    the noise measured on the luminance)."""
     import cv2
 
     grey = _luminance(image)
-    if levels is None or grey is not image:
-        levels = assess(grey)
+    levels = assess(grey, noise=True)
     if levels.noise >= NOISY_LEVELS:
         grey = np.asarray(cv2.blur(grey, (SMOOTHING_KERNEL_PX, SMOOTHING_KERNEL_PX)), np.uint8)
     return np.asarray(cv2.LUT(grey, tone_curve(levels)), np.uint8)
@@ -223,7 +222,7 @@ class FrontEndDetector(ClosesOnExit):
         if self.mode != "off":
             levels = assess(image)
             if self.mode == "always" or levels.needs_curve:
-                image_in = enhance(image, levels)
+                image_in = enhance(image)
                 enhanced = True
         spent_ms = (time.perf_counter() - start) * 1e3
         inner = self._inner_prepare(image_in if enhanced else image)

@@ -210,7 +210,11 @@ class FrontEndDetector(ClosesOnExit):
         self._retry_after_s = -math.inf
 
     def __getattr__(self, name: str) -> Any:
-        return getattr(self.__dict__["detector"], name)
+        """The wrapped detector's other attributes (`video`, `face_mode`, ...)."""
+        detector = self.__dict__.get("detector")
+        if detector is None:
+            raise AttributeError(name)
+        return getattr(detector, name)
 
     def _inner_prepare(self, image: npt.NDArray[np.uint8]) -> Any:
         return self._prepare(image) if self._steps and self._prepare is not None else image
@@ -218,15 +222,10 @@ class FrontEndDetector(ClosesOnExit):
     def prepare(self, image: npt.NDArray[np.uint8]) -> FrontEndPrepared:
         """The frame, enhanced when the mode and the rule say so, prepared for the detector."""
         start = time.perf_counter()
-        enhanced = False
-        if self.mode != "off":
-            levels = assess(image)
-            if self.mode == "always" or levels.needs_curve:
-                image_in = enhance(image)
-                enhanced = True
+        enhanced = self.mode == "always" or (self.mode == "auto" and assess(image).needs_curve)
+        image_in = enhance(image) if enhanced else image
         spent_ms = (time.perf_counter() - start) * 1e3
-        inner = self._inner_prepare(image_in if enhanced else image)
-        return FrontEndPrepared(image, inner, enhanced, spent_ms)
+        return FrontEndPrepared(image, self._inner_prepare(image_in), enhanced, spent_ms)
 
     def _run(self, inner: Any, t_s: float | None) -> Any:
         if self._steps and self._infer is not None:

@@ -129,8 +129,10 @@ def assess(image: npt.NDArray[np.uint8], noise: bool = False) -> FrameLevels:
     mean = float(np.dot(counts, np.arange(256)) / max(float(counts.sum()), 1.0))
     noise_std = 0.0
     if noise:
-        rows = channel[NOISE_ROW_STEP // 2 :: NOISE_ROW_STEP].astype(np.int16)
-        steps = np.abs(np.diff(rows, axis=1)).ravel()
+        import cv2
+
+        rows = np.ascontiguousarray(channel[NOISE_ROW_STEP // 2 :: NOISE_ROW_STEP])
+        steps = cv2.absdiff(rows[:, 1:], rows[:, :-1]).ravel()
         noise_std = 1.4826 * _median_of_counts(np.bincount(steps, minlength=256)) / np.sqrt(2.0)
     return FrameLevels(
         mean=mean, spread=float(p95 - p5), low=float(p1), high=float(p99), noise=noise_std
@@ -155,7 +157,7 @@ def enhance(image: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
     import cv2
 
     grey = _luminance(image)
-    levels = assess(grey, noise=True)
+    levels = assess(grey, noise=True)  # on the luminance (the decision read a colour's green)
     if levels.noise >= NOISY_LEVELS:
         size = (SMOOTHING_KERNEL_PX, SMOOTHING_KERNEL_PX)
         grey = np.asarray(cv2.GaussianBlur(grey, size, 0), np.uint8)

@@ -19,7 +19,10 @@ Runs, with the `roadgaze` of the Python that runs this script:
 3. `roadgaze synth --measure` (the service yaw's recovery on synthetic stills with exact truth);
 4. `roadgaze eval $ROADGAZE_DATA/pointing04-dev --workers 2 --report ...` when the evaluation
    set is there (or beside the development checkout; skipped, and said so, otherwise);
-5. with `--soak S`, `roadgaze bench WORK/demo/drive.mp4 --loop-seconds S --memory --no-raw`.
+5. with `--soak S`, `roadgaze bench WORK/demo/drive.mp4 --loop-seconds S --memory --no-raw`;
+6. the condition suite, `roadgaze eval $ROADGAZE_DATA/pointing04-dev --condition all` with
+   `landmarks.enhance` off and auto, when the evaluation data is there (skip: `--no-conditions`);
+   its two tables are written into docs/conditions.md between its `conditions-table` markers.
 
 The block names the machine (CPU, cores, memory, OS, Python, MediaPipe and OpenCV versions) and
 its load average before and after, because on a shared machine the speed figures move with it.
@@ -138,6 +141,56 @@ def evaluate(work: Path) -> dict[str, Any] | None:
     return document
 
 
+CONDITIONS_DOC = REPO / "docs" / "conditions.md"
+CONDITIONS_MARKERS = ("<!-- conditions-table:start -->", "<!-- conditions-table:end -->")
+
+
+def condition_tables() -> str | None:
+    """The condition suite's tables without and with the front end, as Markdown; None without
+    the evaluation data."""
+    if not POINTING04.is_dir():
+        say(f"{POINTING04} not found: no condition tables")
+        return None
+    parts = []
+    for mode in ("off", "auto"):
+        started = time.perf_counter()
+        output = roadgaze(
+            "eval",
+            str(POINTING04),
+            "--condition",
+            "all",
+            "--workers",
+            "2",
+            "--no-progress",
+            "--set",
+            f"landmarks.enhance={mode}",
+        ).stdout
+        table = [line for line in output.splitlines() if line.startswith("|")]
+        parts += [
+            f"`landmarks.enhance = {mode}` (`roadgaze eval $ROADGAZE_DATA/pointing04-dev "
+            f"--condition all --set landmarks.enhance={mode}`, "
+            f"{time.perf_counter() - started:.0f} s):",
+            "",
+            *table,
+            "",
+        ]
+    return "\n".join(parts).rstrip("\n")
+
+
+def write_condition_tables(tables: str) -> None:
+    """Replace the block between the markers of docs/conditions.md with `tables`."""
+    text = CONDITIONS_DOC.read_text(encoding="utf-8")
+    start, end = CONDITIONS_MARKERS
+    head, found, rest = text.partition(start)
+    _, found_end, tail = rest.partition(end)
+    if not found or not found_end:
+        raise SystemExit(
+            f"measure-readme: the markers {start} / {end} are missing in {CONDITIONS_DOC}"
+        )
+    CONDITIONS_DOC.write_text(f"{head}{start}\n{tables}\n{end}{tail}", encoding="utf-8")
+    say(f"wrote {CONDITIONS_DOC}")
+
+
 def markdown(
     host: str,
     loads: tuple[str, str],
@@ -250,6 +303,9 @@ def main() -> int:
     parser.add_argument("--repeat", type=int, default=3, help="bench passes (default 3)")
     parser.add_argument("--no-eval", action="store_true", help="skip the accuracy run")
     parser.add_argument(
+        "--no-conditions", action="store_true", help="skip the condition suite (docs/conditions.md)"
+    )
+    parser.add_argument(
         "--soak", type=float, default=0.0, metavar="S", help="also a memory run of S seconds"
     )
     parser.add_argument(
@@ -285,6 +341,9 @@ def main() -> int:
         synth_rows = synth_measure()
         eval_run = None if args.no_eval else evaluate(work)
         soak_run = soak(video, args.soak) if args.soak else None
+        tables = None if args.no_conditions else condition_tables()
+        if tables is not None:
+            write_condition_tables(tables)
         after = load_average()
         measured: dict[str, Any] = {
             "host": machine(),

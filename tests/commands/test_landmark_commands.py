@@ -208,3 +208,40 @@ def test_estimate_as_a_process_has_clean_stderr(
         f"roadgaze estimate: {folder / 'corrupt.jpg'}: cannot decode as an image (corrupt or "
         "unsupported format)"
     ]
+
+
+def test_eval_condition_suite_prints_and_writes_one_row_per_condition(
+    folder: Path,
+    tmp_path: Path,
+    real_model: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    monkeypatch.setenv("ROADGAZE_MODEL_PATH", str(real_model))
+    report = tmp_path / "conditions.json"
+    arguments = ["eval", str(folder), "--workers", "1", "--no-progress", "--report", str(report)]
+    assert main([*arguments, "--condition", "sunglasses", "--condition", "dark"]) == 0
+    out = capsys.readouterr().out
+    assert "3 images with |yaw| <= 60, seed 23, landmarks.enhance = auto" in out
+    assert "| clean | 66.7 (2/3) |" in out  # the corrupt file counts as no face
+    rows = {row["condition"]: row for row in json.loads(report.read_text())["conditions"]}
+    assert list(rows) == ["clean", "dark", "sunglasses"]
+    assert rows["clean"]["eye_faces"] == 2 and rows["clean"]["eyes_open"] == 2
+    assert rows["sunglasses"]["faces"] == 2 and rows["sunglasses"]["eyes_closed"] == 0
+    assert rows["sunglasses"]["eyes_open"] < 2  # the lenses hide the eyes
+
+
+@pytest.mark.parametrize(
+    ("extra", "says"),
+    [
+        (["--condition", "fog"], "unknown condition 'fog'"),
+        (["--condition", "all", "--refit"], "--refit is not available with --condition"),
+    ],
+    ids=["unknown", "refit"],
+)
+def test_eval_condition_bad_use_is_one_line_error(
+    folder: Path, capsys: pytest.CaptureFixture[str], extra: list[str], says: str
+) -> None:
+    assert main(["eval", str(folder), "--no-progress", *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and says in err

@@ -64,6 +64,14 @@ def register(subparsers: Any) -> None:
         help="score the candidate landmark choices (docs/landmarks.md) and write a Markdown "
         "table here",
     )
+    parser.add_argument(
+        "--condition",
+        action="append",
+        metavar="NAME",
+        help="run the condition suite instead: the images with |yaw| <= 60, clean and under "
+        "this cabin condition (repeatable, or `all`: ir_grey, dark, glare, motion_blur, jpeg, "
+        "low_res, sunglasses, mask; docs/conditions.md), one table row each",
+    )
     parser.set_defaults(handler=run)
 
 
@@ -94,6 +102,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
                 f"no DATASET_DIR given and {DATA_ENV} is not set; pass the folder with "
                 "ground_truth.csv (`roadgaze data pointing04 SRC OUT` builds one)"
             )
+    if args.condition:
+        _check_condition_options(args)
     check_output_paths(
         {"DATASET_DIR": args.dataset, "ground_truth.csv": args.dataset / "ground_truth.csv"},
         {
@@ -112,6 +122,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
         )
     constants = config.geometry.face_constants()
     model_path = resolve_model(config.model)
+    if args.condition:
+        return run_conditions(args, config, truths, model_path)
     jobs = [(args.dataset / truth.file, truth.file) for truth in truths]
     estimates = list(
         estimate_images(
@@ -147,4 +159,67 @@ def run(args: argparse.Namespace, config: Config) -> int:
         print()
         print(table)
         log_written(args.compare_landmarks)
+    return 0
+
+
+def _check_condition_options(args: argparse.Namespace) -> None:
+    from roadgaze.errors import ConfigError
+    from roadgaze.evaluation.conditions import condition_names
+
+    for flag in ("predictions", "plot", "compare_landmarks"):
+        if getattr(args, flag) is not None:
+            option = "--" + flag.replace("_", "-")
+            raise ConfigError(
+                f"{option} is not available with --condition (the suite's report is "
+                "the table and --report)"
+            )
+    if args.refit:
+        raise ConfigError("--refit is not available with --condition")
+    try:
+        condition_names(args.condition)
+    except ValueError as exc:
+        raise ConfigError(f"--condition: {exc}") from None
+
+
+def run_conditions(
+    args: argparse.Namespace, config: Config, truths: list[Any], model_path: Path
+) -> int:
+    """The condition suite's table on stdout (and its JSON in `--report`)."""
+    import json
+
+    from roadgaze.evaluation.condition_suite import (
+        estimate_conditions,
+        format_condition_table,
+        score_conditions,
+        suite_truths,
+    )
+    from roadgaze.evaluation.conditions import SEED, condition_names
+
+    conditions = condition_names(args.condition)
+    rows = suite_truths(truths)
+    results = estimate_conditions(
+        args.dataset,
+        rows,
+        conditions,
+        config,
+        model_path,
+        workers=max(1, args.workers),
+        progress=not args.no_progress,
+    )
+    table = score_conditions(conditions, rows, results)
+    print(
+        f"Condition suite on {args.dataset}: {len(rows)} images with |yaw| <= 60, seed {SEED}, "
+        f"landmarks.enhance = {config.landmarks.enhance}"
+    )
+    print(format_condition_table(table))
+    if args.report is not None:
+        document = {
+            "dataset": str(args.dataset),
+            "seed": SEED,
+            "enhance": config.landmarks.enhance,
+            "conditions": [row.to_json_dict() for row in table],
+        }
+        args.report.parent.mkdir(parents=True, exist_ok=True)
+        args.report.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
+        log_written(args.report)
     return 0

@@ -113,6 +113,10 @@ class LandmarksConfig(_Section):
     delegate: str = Field(default="xnnpack", min_length=1)
     """LiteRT's delegate: `xnnpack` (its CPU kernels), `none` (builtin kernels, no delegate) or
     the path of a delegate library, e.g. a vehicle NPU's from `ai-edge-litert-sdk-*`."""
+    enhance: Literal["auto", "off", "always"] = "auto"
+    """The front end before the detector (roadgaze.landmarks.front_end): `auto` gives dark or
+    flat frames a contrast curve and looks again with it when no face is found, `off` passes
+    frames as they come, `always` curves every frame (docs/conditions.md)."""
 
 
 class CaptureConfig(_Section):

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import multiprocessing
 from collections.abc import Iterator, Mapping, Sequence
+from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -225,6 +226,16 @@ def estimate_image(
     return estimate_from_detection(label, detection, constants, still)
 
 
+def still_detector(landmarks_config: LandmarksConfig, model_path: Path) -> LandmarkDetector:
+    """The landmarker (`landmarks.engine`) in IMAGE mode behind the front end of
+    `landmarks.enhance`, as the service runs."""
+    from roadgaze.landmarks.front_end import with_front_end
+    from roadgaze.landmarks.landmarker import Landmarker
+
+    landmarker = Landmarker(landmarks_config, model_path, video=False)
+    return with_front_end(landmarker, landmarks_config.enhance)
+
+
 _worker: dict[str, Any] = {}
 
 
@@ -242,9 +253,7 @@ def _init_worker(
 ) -> None:
     from multiprocessing.util import Finalize
 
-    from roadgaze.landmarks.landmarker import Landmarker
-
-    _worker["detector"] = Landmarker(landmarks_config, model_path, video=False)
+    _worker["detector"] = still_detector(landmarks_config, model_path)
     _worker["constants"] = constants
     _worker["still"] = StillPose.from_config(config)
     # Runs when the worker leaves its loop, while MediaPipe's threads are still alive (an atexit
@@ -279,10 +288,8 @@ def estimate_images(
     bar = tqdm(total=len(jobs), desc=description, unit="img", disable=not progress, leave=False)
     try:
         if workers <= 1 or len(jobs) <= 1:
-            from roadgaze.landmarks.landmarker import Landmarker
-
             still = StillPose.from_config(config)
-            with Landmarker(landmarks_config, model_path, video=False) as detector:
+            with closing(still_detector(landmarks_config, model_path)) as detector:
                 for path, name in jobs:
                     yield estimate_image(detector, path, constants, name, still)
                     bar.update(1)

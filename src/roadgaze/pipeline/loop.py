@@ -35,6 +35,7 @@ from roadgaze.pipeline.steps import (
     Inferred,
     Pacer,
     decode_frames,
+    front_end_ms,
     infer_frames,
     infer_one,
 )
@@ -147,9 +148,11 @@ class Pipeline:
         alerts = self.monitor.update(sample, self.speed.kmh_at(frame.t_s))
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)
         after_monitor = clock()
+        enhance_ms, enhance_in_infer_ms = front_end_ms(inferred)
         times = StageTimes(
             decode_ms=inferred.decode_ms,
-            landmarks_ms=inferred.infer_ms + (after_measure - start) * 1e3,
+            enhance_ms=enhance_ms,
+            landmarks_ms=inferred.infer_ms - enhance_in_infer_ms + (after_measure - start) * 1e3,
             handover_ms=(start - inferred.inferred_s) * 1e3,
             geometry_ms=(after_geometry - after_measure) * 1e3,
             smoothing_ms=(after_smoothing - after_geometry) * 1e3,
@@ -270,7 +273,8 @@ def _close_when_stopped(stop: StopSignal, source: FrameSource, done: threading.E
 
 def create_detector(config: Config) -> LandmarkDetector:
     """The production detector: the face landmarker in VIDEO mode on `landmarks.engine` (model via
-    model_store)."""
+    model_store), behind the front end of `landmarks.enhance`."""
     from roadgaze.landmarks import Landmarker
+    from roadgaze.landmarks.front_end import with_front_end
 
-    return Landmarker.from_config(config, video=True)
+    return with_front_end(Landmarker.from_config(config, video=True), config.landmarks.enhance)

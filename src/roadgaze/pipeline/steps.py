@@ -47,6 +47,15 @@ def lower_this_thread_priority(niceness: int) -> None:
         )
 
 
+def front_end_ms(inferred: Inferred) -> tuple[float, float]:
+    """The front end's time on a frame (`roadgaze.landmarks.front_end`) and how much of it lies
+    within `inferred.infer_ms`; (0, 0) for a detector without a front end."""
+    inference = inferred.inference
+    prepare_ms = float(getattr(inference, "prepare_ms", 0.0))
+    retry_ms = float(getattr(inference, "retry_ms", 0.0))
+    return prepare_ms + retry_ms, retry_ms + (prepare_ms if inferred.prepared_here else 0.0)
+
+
 def _already_measured(detection: Any) -> Detection:
     """`measure` of a detector whose `detect` does all of the landmark stage at once."""
     return detection  # type: ignore[no-any-return]
@@ -116,6 +125,8 @@ class Inferred:
     pacing): the start of the frame's latency."""
     inferred_s: float
     """When `infer` ended (the loop's clock)."""
+    prepared_here: bool = False
+    """The image was prepared inside `infer`'s time (no decode thread prepared it)."""
 
     @property
     def infer_ms(self) -> float:
@@ -133,7 +144,8 @@ def infer_one(
     now: the start of its latency."""
     received_s = clock()
     inference = steps.infer(steps.input_of(frame, prepared), frame.t_s)
-    return Inferred(frame, inference, decode_ms, received_s, clock())
+    here = prepared is None and steps.prepare is not None
+    return Inferred(frame, inference, decode_ms, received_s, clock(), here)
 
 
 class Pacer:

@@ -12,6 +12,7 @@ from roadgaze.capture import SourceStatus
 
 STAGES = (
     "decode",
+    "enhance",
     "landmarks",
     "handover",
     "geometry",
@@ -40,6 +41,10 @@ class StageTimes:
     total_ms: float
     handover_ms: float = 0.0
     """From the end of MediaPipe's work in the landmark thread to the loop taking the frame."""
+    enhance_ms: float = 0.0
+    """The front end's own time (roadgaze.landmarks.front_end: the decision and, on the frames
+    that need it, the contrast curve; a second look's curve); not part of `landmarks`. For a file
+    it runs on the decode thread, ahead of the frame, so it is not in `total` either."""
 
     def as_tuple(self) -> tuple[float, ...]:
         """The times in `STAGES` order."""

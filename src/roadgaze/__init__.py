@@ -5,4 +5,4 @@ Pipeline: capture -> MediaPipe FaceLandmarker -> Center-CE face model -> Kalman 
 turned to the driver's own left (ISO 8855); pitch > 0 means looking up.
 """
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"

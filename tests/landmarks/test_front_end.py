@@ -183,3 +183,15 @@ def test_real_mediapipe_finds_an_ir_face_only_through_the_front_end(
     with FrontEndDetector(MediaPipeLandmarker(Config().landmarks, model, video=True)) as stream:
         found = [stream.detect(ir_astronaut, i / 15).driver is not None for i in range(5)]
     assert all(found)
+
+
+@pytest.mark.parametrize("shape", [(4, 4), (1, 1), (4, 4, 3), (7, 1, 3), (1, 300)])
+def test_a_frame_too_small_for_a_noise_row_is_assessed_and_enhanced(
+    shape: tuple[int, ...],
+) -> None:
+    """A damaged image decoded to a few pixels (a truncated JPEG) still gets its figures and its
+    curve: no noise row to measure, so no noise (an exception here stopped `eval` on one file)."""
+    frame = np.zeros(shape, np.uint8)
+    levels = assess(frame, noise=True)
+    assert levels.noise == 0.0 and levels.mean == 0.0
+    assert enhance(frame).shape[:2] == shape[:2]

@@ -128,10 +128,10 @@ def assess(image: npt.NDArray[np.uint8], noise: bool = False) -> FrameLevels:
     p1, p5, p95, p99 = np.searchsorted(cumulative, (0.01, 0.05, 0.95, 0.99))
     mean = float(np.dot(counts, np.arange(256)) / max(float(counts.sum()), 1.0))
     noise_std = 0.0
-    if noise:
+    rows = np.ascontiguousarray(channel[NOISE_ROW_STEP // 2 :: NOISE_ROW_STEP])
+    if noise and rows.shape[0] > 0 and rows.shape[1] > 1:  # a frame too small has no noise row
         import cv2
 
-        rows = np.ascontiguousarray(channel[NOISE_ROW_STEP // 2 :: NOISE_ROW_STEP])
         steps = cv2.absdiff(rows[:, 1:], rows[:, :-1]).ravel()
         noise_std = 1.4826 * _median_of_counts(np.bincount(steps, minlength=256)) / np.sqrt(2.0)
     return FrameLevels(

@@ -16,7 +16,9 @@
 #   SUITE        Debian suite                    (default bookworm; Python 3.11)
 #   MIRROR       Debian mirror URL               (default: the first Debian mirror in apt's sources)
 #   ENGINE       podman or docker                (default: podman if installed, else docker)
-#   STORAGE_DRIVER  podman --storage-driver      (default vfs: works in containers/VMs without overlay)
+#   STORAGE_DRIVER  podman's storage driver      (default vfs: works in containers/VMs without overlay),
+#                in a store of its own (ROADGAZE_STORE; docker/podman-store.sh says why); empty:
+#                podman's default store
 #   WORKDIR      where the root tree is built    (default: a temporary directory, removed afterwards)
 #   FORCE=1      rebuild even if the image exists
 set -euo pipefail
@@ -24,7 +26,9 @@ set -euo pipefail
 BASE_IMAGE="${BASE_IMAGE:-localhost/debian-py:bookworm}"
 SUITE="${SUITE:-bookworm}"
 PACKAGES="python3,python3-venv,libegl1,libgles2,ca-certificates"
-STORAGE_DRIVER="${STORAGE_DRIVER:-vfs}"
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+# shellcheck source=podman-store.sh
+source "$here/podman-store.sh"
 FORCE="${FORCE:-0}"
 
 log() { printf 'offline-base: %s\n' "$*" >&2; }
@@ -40,7 +44,10 @@ if [[ -z "${ENGINE:-}" ]]; then
     fi
 fi
 engine=("$ENGINE")
-if [[ "$ENGINE" == podman ]]; then engine+=(--storage-driver "$STORAGE_DRIVER"); fi
+if [[ "$ENGINE" == podman ]]; then
+    roadgaze_podman_store
+    [[ -z "${CONTAINERS_STORAGE_CONF:-}" ]] || log "podman store: $CONTAINERS_STORAGE_CONF"
+fi
 
 if [[ "$FORCE" != 1 ]] && "${engine[@]}" image exists "$BASE_IMAGE" 2>/dev/null; then
     log "$BASE_IMAGE already exists ($ENGINE); nothing to do (FORCE=1 rebuilds it)"

@@ -25,7 +25,9 @@
 #   SECURE=0                 plain TCP without certificates or access control (default 1)
 #   PORT                     router port (default 7447; with NETWORK=host it must be free)
 #   RUNTIME                  podman --runtime (e.g. runc where crun fails on the host's cgroups)
-#   STORAGE_DRIVER           podman --storage-driver (e.g. vfs; podman remembers the store's driver)
+#   STORAGE_DRIVER           podman's storage driver, default vfs, in a store of its own
+#                            (ROADGAZE_STORE, shared with offline-base.sh; docker/podman-store.sh);
+#                            empty: podman's default store
 #   KEEP=1                   keep containers and the work folder for inspection
 set -euo pipefail
 
@@ -59,7 +61,9 @@ fi
 engine=("$ENGINE")
 run_opts=()
 if [[ "$ENGINE" == podman ]]; then
-    [[ -n "${STORAGE_DRIVER:-}" ]] && engine+=(--storage-driver "$STORAGE_DRIVER")
+    # shellcheck source=podman-store.sh
+    source "$here/podman-store.sh"
+    roadgaze_podman_store
     [[ -n "${RUNTIME:-}" ]] && run_opts+=(--runtime "$RUNTIME")
 fi
 e() { "${engine[@]}" "$@"; }
@@ -82,7 +86,7 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 130' INT TERM
 
-say "engine: $("${engine[@]}" --version)"
+say "engine: $("${engine[@]}" --version)${CONTAINERS_STORAGE_CONF:+, store $CONTAINERS_STORAGE_CONF}"
 t_total=$(now)
 
 # ----------------------------------------------------------------------------------- build
@@ -110,6 +114,8 @@ if [[ "${SKIP_BUILD:-0}" != 1 ]]; then
     e "${build[@]}" "$repo" > "$work/build.log" 2>&1 \
         || { tail -n 40 "$work/build.log" >&2; fail "image build failed (log above)"; }
     info "built in $(since "$t") s; size $(e image inspect --format '{{.Size}}' "$IMAGE" | awk '{printf "%.0f MB", $1/1e6}')"
+    # The build stage's image (about 1.4 GB, untagged; podman keeps it) is of no further use.
+    e image prune -f --filter label=org.roadgaze.stage=build >/dev/null 2>&1 || true
 else
     e image inspect "$IMAGE" >/dev/null 2>&1 || fail "SKIP_BUILD=1 but there is no image $IMAGE"
 fi

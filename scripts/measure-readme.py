@@ -3,13 +3,22 @@
 
     .venv/bin/python scripts/measure-readme.py [--work DIR] [--repeat N] [--no-eval]
                                                [--soak SECONDS]
+    .venv/bin/python scripts/measure-readme.py --check [--cheap] | --update
+
+`--check` runs the command of every deterministic figure the README and docs state
+(`scripts/documented_figures.py`: accuracy, synthetic recovery, smoothers, eyes, the paper's
+tables) and exits 1, listing each difference, when a document no longer says what its command
+prints; `--cheap` only the quick ones (what `tests/test_documented_figures.py` runs); `--update`
+writes the printed values into the documents instead.
+
+Without `--check`/`--update`, the timed figures (the Measured block):
 
 Runs, with the `roadgaze` of the Python that runs this script:
 1. `roadgaze demo --out WORK/demo`, timed (the demo's own render/service/total split too);
 2. `roadgaze bench WORK/demo/drive.mp4 --json --repeat N --latency` on the demo's drive;
 3. `roadgaze synth --measure` (the service yaw's recovery on synthetic stills with exact truth);
-4. `roadgaze eval ../shared/data/pointing04-dev --workers 2 --report ...` when the evaluation
-   data sits beside the checkout (skipped, and said so, otherwise);
+4. `roadgaze eval $ROADGAZE_DATA/pointing04-dev --workers 2 --report ...` when the evaluation
+   set is there (or beside the development checkout; skipped, and said so, otherwise);
 5. with `--soak S`, `roadgaze bench WORK/demo/drive.mp4 --loop-seconds S --memory --no-raw`.
 
 The block names the machine (CPU, cores, memory, OS, Python, MediaPipe and OpenCV versions) and
@@ -33,17 +42,10 @@ from pathlib import Path
 from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
-POINTING04 = REPO.parent / "shared" / "data" / "pointing04-dev"
-METHOD_LABELS = {
-    "cylindrical": "Cylindrical",
-    "ellipsoidal": "Ellipsoidal",
-    "ce": "CE",
-    "center_ce": "Center-CE",
-    "boundary_ce": "Boundary-CE",
-    "service": "**Service yaw** (Center-CE, full range)",
-    "mediapipe": "MediaPipe's own matrix yaw (peer)",
-}
-"""The rows of the accuracy table, in order; a method the report lacks is left out."""
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from documented_figures import EVAL_METHODS as METHOD_LABELS  # noqa: E402
+from documented_figures import POINTING04  # noqa: E402
+
 BOLD = "service"
 
 
@@ -197,7 +199,7 @@ def markdown(
         lines += [
             "",
             f"Accuracy on Pointing'04 subjects 1-10, \\|yaw\\| <= 60 (`roadgaze eval "
-            f"../shared/data/pointing04-dev --workers 2`, {eval_run['wall_s']:.0f} s):",
+            f"$ROADGAZE_DATA/pointing04-dev --workers 2`, {eval_run['wall_s']:.0f} s):",
             "",
             "| method | MAE (deg) | RMSE | median | face found |",
             "|---|---|---|---|---|",
@@ -211,7 +213,35 @@ def markdown(
                 f"| {label} | {bold}{stats['mae_deg']:.2f}{bold} | {stats['rmse_deg']:.2f} | "
                 f"{stats['median_abs_error_deg']:.2f} | {100 * stats['detection_rate']:.1f}% |"
             )
+        cross = eval_run.get("cross_validation")
+        if cross is not None:
+            ranges = cross["ranges"]
+            lines += [
+                "",
+                "With the blend's two constants re-fitted leaving each subject out, the service's "
+                f"yaw gives {ranges['abs_yaw_le_60']['service_cv']['mae_deg']:.2f} within +-60 "
+                f"and {ranges['all']['service_cv']['mae_deg']:.2f} over all poses.",
+            ]
     return "\n".join(lines)
+
+
+def check_documents(work: Path | None, cheap: bool, update: bool, only: str | None) -> int:
+    from documented_figures import FIGURES, check_figures
+
+    figures = [
+        figure
+        for figure in FIGURES
+        if (figure.cheap or not cheap) and (only is None or only in figure.name)
+    ]
+    with tempfile.TemporaryDirectory(prefix="roadgaze-figures-") as scratch:
+        folder = work or Path(scratch)
+        folder.mkdir(parents=True, exist_ok=True)
+        problems = check_figures(figures, folder, update=update, say=say)
+    for problem in problems:
+        print(("updated " if update else "") + str(problem))
+    places = sum(len(figure.places) for figure in figures)
+    say(f"{len(figures)} commands, {places} places, {len(problems)} differences")
+    return 1 if problems and not update else 0
 
 
 def main() -> int:
@@ -228,7 +258,19 @@ def main() -> int:
         metavar="WORK",
         help="print the block again from the measured.json of an earlier run's --work folder",
     )
+    parser.add_argument(
+        "--check", action="store_true", help="compare the documented figures with their commands"
+    )
+    parser.add_argument("--cheap", action="store_true", help="with --check: the quick ones only")
+    parser.add_argument(
+        "--only", metavar="TEXT", help="with --check/--update: the figures whose name holds TEXT"
+    )
+    parser.add_argument(
+        "--update", action="store_true", help="write the commands' figures into the documents"
+    )
     args = parser.parse_args()
+    if args.check or args.update:
+        return check_documents(args.work, args.cheap, args.update, args.only)
     if args.render is not None:
         saved = json.loads((args.render / "measured.json").read_text())
         print(markdown(**saved))

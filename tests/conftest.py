@@ -30,7 +30,7 @@ def subprocess_env() -> dict[str, str]:
     return child_env()
 
 
-# --- Synthetic ground-truth video (roadgaze.synth): fixtures that need no ../shared data -------
+# --- Synthetic ground-truth video (roadgaze.synth): fixtures that need no evaluation data -------
 
 SYNTHETIC_SIZE = (320, 320)
 SYNTHETIC_FPS = 15.0

@@ -1,11 +1,13 @@
 """`roadgaze run` in a child process with a scripted camera and detector (no MediaPipe).
 
-    python tests/fake_daemon.py [--frame-s S] RUN_ARGUMENTS...
+    python tests/fake_daemon.py [--frame-s S] [--slow-del S] RUN_ARGUMENTS...
 
 Everything but the camera and the landmark model is real: signals, the Zenoh link, the monitor,
 health and the final state. The face looks at the road for 1 s, then 30 deg to the right (zone
 away) for 5 s, over and over (a long-distraction alert and its clear every 6 s); each frame takes
-`--frame-s` (default 1/30 s), so a test can make a frame long enough to signal twice during it.
+`--frame-s` (default 1/30 s), so a test can make a frame long enough to signal twice during it;
+`--slow-del S` makes the detector's finaliser take S seconds (as MediaPipe's
+`FaceLandmarker.__del__` can), so a second signal can land inside it.
 """
 
 from __future__ import annotations
@@ -66,15 +68,30 @@ class GlancingDetector:
         return None
 
 
+class SlowFinalisedDetector(GlancingDetector):
+    """A detector whose `__del__` takes `del_s` seconds."""
+
+    def __init__(self, frame_s: float, del_s: float) -> None:
+        super().__init__(frame_s)
+        self.del_s = del_s
+
+    def __del__(self) -> None:
+        time.sleep(self.del_s)
+
+
 def main(argv: list[str]) -> int:
     import roadgaze.capture
     import roadgaze.pipeline
     from roadgaze.cli import main as roadgaze_main
 
-    frame_s = 1.0 / FPS
+    frame_s, del_s = 1.0 / FPS, 0.0
     if argv[:1] == ["--frame-s"]:
         frame_s, argv = float(argv[1]), argv[2:]
-    roadgaze.pipeline.create_detector = lambda config: GlancingDetector(frame_s)  # type: ignore[assignment]
+    if argv[:1] == ["--slow-del"]:
+        del_s, argv = float(argv[1]), argv[2:]
+    roadgaze.pipeline.create_detector = lambda config: (  # type: ignore[assignment]
+        SlowFinalisedDetector(frame_s, del_s) if del_s else GlancingDetector(frame_s)
+    )
     roadgaze.capture.open_source = lambda *args, **kwargs: EndlessSource()  # type: ignore[assignment]
     return roadgaze_main(["run", "--source", "fake-camera", *argv])
 

@@ -1,7 +1,9 @@
 """Where the checkout, its sources and the evaluation data are, for every test module.
 
-The evaluation data (`../shared/data`) sits beside the development checkout and in CI; a fresh
-clone does not have it, so tests that need it skip with a reason.
+The evaluation data is found in `$ROADGAZE_DATA` when it is set, else in `../shared/data` beside
+the checkout (the development machines and CI); a fresh clone has neither, so tests that need it
+skip with a reason. `roadgaze data pointing04 SRC $ROADGAZE_DATA/pointing04-dev` builds the
+Pointing'04 set from the public archive.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 SRC = REPO / "src"
-SHARED_DATA = REPO.parent / "shared" / "data"
+SHARED_DATA = Path(os.environ.get("ROADGAZE_DATA") or REPO.parent / "shared" / "data")
 POINTING04 = SHARED_DATA / "pointing04-dev"
 VIDEOS = SHARED_DATA / "videos"
 

@@ -461,9 +461,14 @@ def test_signal_matrix(
 
     import roadgaze.capture
     import roadgaze.pipeline
+    import roadgaze.service.signals
     from fake_daemon import EndlessSource, GlancingDetector
     from roadgaze.cli import main
 
+    def exit_now(code: int) -> None:  # the real one ends this test process at once
+        raise SystemExit(code)
+
+    monkeypatch.setattr(roadgaze.service.signals, "exit_now", exit_now)
     frame_s = 0.05 if times == 1 else 1.5
     monkeypatch.setattr(roadgaze.pipeline, "create_detector", lambda c: GlancingDetector(frame_s))
     monkeypatch.setattr(roadgaze.capture, "open_source", lambda *a, **k: EndlessSource())

@@ -107,6 +107,8 @@ def test_cli_demo_prints_alerts_as_received(tmp_path: Path, subprocess_env: dict
         ["drive.mp4", "truth.csv", "frames.jsonl", "alerts.jsonl", "yaw.png", "annotated.mp4"]
     )
     assert "demo: rendering" in result.stderr
+    # A normal finish: no warning (the subscriber leaving first used to read as a link down).
+    assert " WARNING " not in result.stderr and "link down" not in result.stderr
 
 
 def test_cli_demo_rejects_a_bad_timeline(tmp_path: Path, subprocess_env: dict[str, str]) -> None:

@@ -94,3 +94,68 @@ def test_the_unit_asks_for_what_the_daemon_implements() -> None:
     for hardening in ("ProtectSystem", "PrivateTmp", "NoNewPrivileges", "DevicePolicy"):
         assert hardening in settings
     assert settings["DeviceAllow"] == ["/dev/video0 rw"]
+
+
+def install_steps(unit_text: str) -> list[str]:
+    """The command lines of the unit header's install steps, in order."""
+    header = unit_text.split("# Install, as root, in this order:")[1].split("\n#\n")[0]
+    return [line[4:] for line in header.splitlines() if line.startswith("#   ")]
+
+
+def test_the_install_steps_create_what_the_unit_and_the_fetch_need() -> None:
+    text = UNIT.read_text(encoding="utf-8")
+    settings = unit_settings(text)
+    steps = install_steps(text)
+    index = {
+        name: next(i for i, step in enumerate(steps) if needle in step)
+        for name, needle in (
+            ("clone", "git clone"),
+            ("user", "useradd"),
+            ("cache", "install -d -o roadgaze -g roadgaze -m 0750 /var/cache/roadgaze"),
+            ("fetch", "roadgaze model fetch"),
+            ("enable", "systemctl enable"),
+        )
+    }
+    # The fetch runs as `roadgaze` before the service ever started, so before CacheDirectory=
+    # made /var/cache/roadgaze: the folder is made for it, with the unit's owner and mode.
+    assert index["user"] < index["cache"] < index["fetch"] < index["enable"]
+    assert settings["CacheDirectory"] == ["roadgaze"] and settings["CacheDirectoryMode"] == ["0750"]
+    assert "ROADGAZE_CACHE_DIR=/var/cache/roadgaze" in steps[index["fetch"]]
+    # Documentation= names a file the steps put there: the clone's docs/deployment.md.
+    (documentation,) = settings["Documentation"]
+    clone_dir = steps[index["clone"]].split("#")[0].split()[-1]
+    assert documentation.startswith(f"file://{clone_dir}/")
+    assert (REPO / documentation.removeprefix(f"file://{clone_dir}/")).is_file()
+
+
+def store_conf(tmp_path: Path, **env: str) -> str:
+    """What `roadgaze_podman_store` exports, for a given environment ('' when nothing)."""
+    script = f'source "{REPO}/docker/podman-store.sh"; roadgaze_podman_store; '
+    script += 'printf %s "${CONTAINERS_STORAGE_CONF:-}"'
+    clean = {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), "ROADGAZE_STORE": str(tmp_path)}
+    result = subprocess.run(
+        ["bash", "-c", script], env=clean | env, capture_output=True, text=True, check=True
+    )
+    return result.stdout
+
+
+def test_the_container_scripts_use_a_podman_store_of_their_own(tmp_path: Path) -> None:
+    """A default store used before with another driver refuses --storage-driver vfs, so the
+    scripts name a private store (driver, graphroot, runroot) instead of passing the flag."""
+    conf = store_conf(tmp_path)
+    assert conf == str(tmp_path / "storage.conf")
+    text = Path(conf).read_text()
+    assert 'driver = "vfs"' in text and f'graphroot = "{tmp_path}/storage-vfs"' in text
+    assert "runroot = " in text
+    assert store_conf(tmp_path, STORAGE_DRIVER="") == ""  # podman's default store
+    assert store_conf(tmp_path, CONTAINERS_STORAGE_CONF="/etc/mine.conf") == "/etc/mine.conf"
+    for script in ("smoke.sh", "offline-base.sh"):
+        body = (REPO / "docker" / script).read_text()
+        assert "roadgaze_podman_store" in body
+        assert "+=(--storage-driver" not in body
+    # The build stage's image is labelled, and smoke.sh removes what carries the label.
+    assert "LABEL org.roadgaze.stage=build" in (REPO / "docker" / "Dockerfile").read_text()
+    assert (
+        "prune -f --filter label=org.roadgaze.stage=build"
+        in (REPO / "docker" / "smoke.sh").read_text()
+    )

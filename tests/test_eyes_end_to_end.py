@@ -1,5 +1,5 @@
 """The eyes end to end on a rendered drive: real MediaPipe, the pipeline, the monitor's alerts at
-their times, the records and the VSS signals (no ../shared data needed)."""
+their times, the records and the VSS signals (no evaluation data needed)."""
 
 from __future__ import annotations
 

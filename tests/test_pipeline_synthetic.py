@@ -1,4 +1,4 @@
-"""The pipeline and the monitor on synthetic clips with known yaw (no ../shared data needed)."""
+"""The pipeline and the monitor on synthetic clips with known yaw (no evaluation data needed)."""
 
 from __future__ import annotations
 

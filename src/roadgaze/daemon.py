@@ -4,11 +4,14 @@
 queries and the `BusPublisher` sink; `roadgaze run`, `roadgaze replay --publish` and the demo use
 it. `run_daemon` adds the signal handlers (SIGINT, SIGTERM, SIGHUP) and a source that waits for
 a camera, runs `Pipeline.run` until the source ends or a stop, publishes a final state,
-undeclares everything and returns 0.
+undeclares everything and returns 0, or `EXIT_UNDELIVERED` (4) when alerts never reached the
+bus (no link before the end, after waiting `zenoh.delivery_wait_s` for one; pushed out of the
+publisher's cache; a failed put): a warning names them.
 """
 
 from __future__ import annotations
 
+import gc
 import logging
 from collections.abc import Iterator
 from contextlib import ExitStack, closing, contextmanager
@@ -27,6 +30,9 @@ from roadgaze.types import Alert, AlertKind
 
 log = logging.getLogger("roadgaze.daemon")
 
+EXIT_UNDELIVERED = 4
+"""Exit status of `run` and `replay --publish` when some alerts never reached the bus."""
+
 
 @dataclass(frozen=True, slots=True)
 class BusOutputs:
@@ -36,6 +42,13 @@ class BusOutputs:
     sinks: tuple[Sink, ...]
     speed: SpeedSource
     link: ZenohLink | None
+
+    def undelivered(self) -> int:
+        """Alerts that never reached the bus (after the `bus_outputs` block: the final count)."""
+        if self.link is None:
+            return 0
+        waiting, gone, _ = self.link.undelivered()
+        return waiting + gone
 
 
 @contextmanager
@@ -74,7 +87,25 @@ def bus_outputs(
             )
         finally:
             health.status = "stopped"
+            link.settle(config.zenoh.delivery_wait_s)
+            link.stop_ledger()
             link.publish_final_state()
+            _report_undelivered(link, health, logging.getLogger(log_name))
+
+
+def _report_undelivered(link: ZenohLink, health: Health, logger: logging.Logger) -> None:
+    """The warning naming the alerts that never reached the bus, if any."""
+    _, gone, named = link.undelivered()
+    if not gone:
+        return
+    logger.warning(
+        "%d of %d alerts never reached the zenoh bus (exit status %d): %s%s",
+        gone,
+        health.alerts_raised,
+        EXIT_UNDELIVERED,
+        "; ".join(named),
+        "" if gone <= len(named) else f"; and {gone - len(named)} older ones",
+    )
 
 
 def _publish_failure(bus: BusOutputs, alert: Alert) -> None:
@@ -96,7 +127,8 @@ def run_daemon(
     record_dir: Path | None = None,
     foxglove: str | None = None,
 ) -> int:
-    """Monitor `source_spec` and publish until the source ends or a stop; returns 0.
+    """Monitor `source_spec` and publish until the source ends or a stop; returns 0, or
+    `EXIT_UNDELIVERED` when some alerts never reached the bus (a warning names them).
 
     A camera that cannot be opened is waited for with backoff (capture.reconnect_*) and reported
     in the state as degraded; a missing file is a `SourceError`. An unreachable Zenoh peer never
@@ -163,4 +195,7 @@ def run_daemon(
             health.frames,
             health.alerts_raised,
         )
-    return 0
+    # MediaPipe's objects are finalised here, while the stop handlers still stand (a second
+    # signal during a finaliser then exits 1 at once, never "Exception ignored" and exit 130).
+    gc.collect()
+    return EXIT_UNDELIVERED if bus.undelivered() else 0

@@ -225,11 +225,14 @@ def run_demo(
         source = stack.enter_context(open_source(str(video_path), config))
         detector = create_detector(config)
         stack.callback(detector.close)
+        # The subscriber closes after the service's session: a subscriber leaving first is a
+        # link going down to the service, which warns that alerts are held.
+        subscribers = stack.enter_context(ExitStack())
         bus = stack.enter_context(bus_outputs(config, str(video_path), publish=True))
         subscriber = AlertSubscriber(
             subscriber_config(config, port), out_dir / ALERTS_NAME, on_alert
         )
-        stack.callback(subscriber.close)
+        subscribers.callback(subscriber.close)
         if not subscriber.wait_for_publisher(SUBSCRIBER_WAIT_S):
             log.warning("the subscriber did not see the publisher within %.0f s", SUBSCRIBER_WAIT_S)
         frames_writer = stack.enter_context(JsonlWriter(out_dir / FRAMES_NAME))

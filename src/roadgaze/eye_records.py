@@ -27,6 +27,18 @@ class EyeStatus(StrEnum):
     """Not measurable: no face, a turned head, sunglasses, eyes too small or low confidence."""
 
 
+class EyeCalibrationStatus(StrEnum):
+    """How far the driver's resting eye direction is learned (roadgaze.monitor.eye_calibration):
+    the eyes may move the gaze only once it is `calibrated`."""
+
+    NONE = "none"
+    """Nothing learned yet: the gaze is the head pose."""
+    LEARNING = "learning"
+    """Learning from open-eyed samples on the road: the gaze is still the head pose."""
+    CALIBRATED = "calibrated"
+    """Learned: eye movements beyond the driver's measured noise move the gaze."""
+
+
 @dataclass(frozen=True, slots=True)
 class EyeMeasurement:
     """One eye at one frame (`side` is the person's own: "right" or "left").
@@ -71,6 +83,9 @@ class EyesFeatures:
     """Why the eyes are unavailable for gaze ('' when at least one eye gives a direction)."""
     occluded: bool = False
     """The image check says the eyes cannot be seen (sunglasses, glare, a hand)."""
+    blurred: bool = False
+    """The image check finds no sharp edges around the measured eyes (motion blur, glare): lids
+    that read closed cannot be judged."""
 
     @property
     def gaze_available(self) -> bool:
@@ -145,3 +160,6 @@ class EyesVerdict:
     """How long the eyes have been unavailable while moving."""
     degraded: bool = False
     """Monitoring impaired: eyes unavailable for `degraded_after_s` (head pose only)."""
+    calibration: EyeCalibrationStatus = EyeCalibrationStatus.NONE
+    """How far the driver's resting eye direction is learned; the eyes move the gaze only once
+    `calibrated`."""

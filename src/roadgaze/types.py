@@ -23,6 +23,7 @@ from typing import Protocol, Self
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.eye_records import EyeCalibrationStatus as EyeCalibrationStatus
 from roadgaze.eye_records import EyeMeasurement as EyeMeasurement
 from roadgaze.eye_records import EyesFeatures as EyesFeatures
 from roadgaze.eye_records import EyeStatus as EyeStatus
@@ -80,6 +81,10 @@ class FaceFeatures:
     """Contrast inside the (right, left) eye opening relative to the skin below the eye
     (`roadgaze.landmarks.eyes.eye_contrast`; NaN where the eye is too small to measure); None
     when not measured. Low in both eyes while the lids look open: sunglasses or an occlusion."""
+    eye_sharpness: tuple[float, float] | None = None
+    """Edge strength around the (right, left) eye relative to the skin below it
+    (`roadgaze.landmarks.eye_contrast.eye_sharpness`; NaN where too small); None when not
+    measured. Low: motion blur or glare, lids that read closed cannot be judged."""
 
 
 @dataclass(frozen=True, slots=True)

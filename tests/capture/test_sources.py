@@ -101,7 +101,7 @@ def test_missing_file_is_one_clear_error(tmp_path: Path) -> None:
         VideoFileSource(tmp_path / "nope.mp4")
 
 
-@pytest.mark.skipif(not VIDEOS.is_dir(), reason="../shared/data/videos not present")
+@pytest.mark.skipif(not VIDEOS.is_dir(), reason="no evaluation videos ($ROADGAZE_DATA)")
 def test_animated_gif_frames_and_times() -> None:
     with VideoFileSource(VIDEOS / "head-pose-face-detection-female.gif") as source:
         frames = list(source)

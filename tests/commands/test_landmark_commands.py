@@ -128,6 +128,11 @@ def test_estimate_prints_one_json_object_per_image(
     assert mirrored["yaw_deg"] == pytest.approx(-first["yaw_deg"], abs=1.0)
     assert missing["face"] is False and "file not found" in missing["error"]
     assert "file not found" in captured.err
+    # Rounded as `replay` rounds: angles to 3 decimals, pixels to 2 (not 16 digits).
+    assert first["yaw_deg"] == round(first["yaw_deg"], 3)
+    assert first["mediapipe_pitch_deg"] == round(first["mediapipe_pitch_deg"], 3)
+    assert first["x_left"] == round(first["x_left"], 2)
+    assert all(len(repr(value)) <= 9 for value in first["models"].values())
 
 
 def test_eval_writes_every_output(

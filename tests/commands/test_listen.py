@@ -21,7 +21,15 @@ from repo_paths import child_env
 from roadgaze.config import Config, ZenohConfig
 from roadgaze.transport import Health, Keys
 from roadgaze.types import PoseSample
-from zenoh_helpers import LineReader, endpoint, free_port, router, stop_process, wait_for
+from zenoh_helpers import (
+    LineReader,
+    client_config,
+    endpoint,
+    free_port,
+    router,
+    stop_process,
+    wait_for,
+)
 
 VEHICLE = "car-1"
 ALERT_KEY = f"vehicle/{VEHICLE}/dms/alert"
@@ -54,19 +62,31 @@ def valid_state(**changes: Any) -> bytes:
     return json.dumps(document).encode()
 
 
+def daemon_publisher(session: zenoh.Session) -> Any:
+    """An advanced publisher of the vehicle's alerts, as the daemon declares it."""
+    from zenoh.ext import CacheConfig, MissDetectionConfig, declare_advanced_publisher
+
+    return declare_advanced_publisher(
+        session,
+        ALERT_KEY,
+        cache=CacheConfig(max_samples=10),
+        sample_miss_detection=MissDetectionConfig(heartbeat=0.5),  # type: ignore[call-arg]
+        publisher_detection=True,
+    )
+
+
 def test_hostile_payloads_are_reported_and_the_valid_alert_printed_once() -> None:
     port = free_port()
-    with router(port) as attacker:
+    with router(port) as attacker, zenoh.open(client_config([endpoint(port)])) as session:
+        daemon = daemon_publisher(session)
         process = listen(port, "--json", "--no-yaw", "--timeout", "30")
         try:
             reader = LineReader(process)
-            # Until the subscription has propagated, put a valid alert of another publisher.
+            # Until the subscription has propagated: the daemon's first alert (history gives
+            # it once the subscriber is there).
             probe = alert_message(0, VEHICLE).to_json_bytes()
-            for _ in range(100):
-                attacker.put(ALERT_KEY, probe)
-                line = reader.next(0.2)
-                if line is not None:
-                    break
+            daemon.put(probe)
+            line = reader.next(20.0)
             assert line is not None and json.loads(line)["payload"]["seq"] == 0
             hostile = [
                 b"[" * 100_000,  # over the size limit: not even copied
@@ -80,11 +100,10 @@ def test_hostile_payloads_are_reported_and_the_valid_alert_printed_once() -> Non
             block = zenoh.CongestionControl.BLOCK  # the default (DROP) may lose some under load
             for payload in hostile:
                 attacker.put(ALERT_KEY, payload, congestion_control=block)
+            daemon.put(probe)  # a duplicate of seq 0 from the daemon's own publisher
             state = valid_state(source="cam\ud800\x1b[2J", problems=["\udfff"])
             attacker.put(STATE_KEY, state, congestion_control=block)
-            attacker.put(
-                ALERT_KEY, alert_message(1, VEHICLE).to_json_bytes(), congestion_control=block
-            )
+            daemon.put(alert_message(1, VEHICLE).to_json_bytes())
             received = [json.loads(reader.next(10.0) or "null") for _ in range(2)]
             stderr = stop_cleanly(process)
         finally:
@@ -94,6 +113,9 @@ def test_hostile_payloads_are_reported_and_the_valid_alert_printed_once() -> Non
     assert by_type["state"]["source"] == "cam\ud800\x1b[2J"  # escaped by json.dumps
     assert by_type["alert"]["seq"] == 1
     assert "message rejected" in stderr and "limit 65536" in stderr
+    # The plain put of a valid alert (the duplicate in `hostile`) is another publisher's.
+    assert stderr.count("SUSPICIOUS alert #0") == 1
+    assert "totals: 2 alerts printed, 0 missed, 7 messages rejected, 1 foreign" in stderr
 
 
 def test_vss_values_from_the_bus_are_checked_before_they_are_printed() -> None:

@@ -37,6 +37,8 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     eye_fields |= {"closure_s", "perclos", "blinks", "eyes_unavailable_s", "degraded"}
     assert eye_fields <= set(schemas["yaw"]["required"])
     assert eye_fields <= set(snapshot["required"])
+    # state/4 adds the eye calibration to the monitor
+    assert "eye_calibration" in snapshot["required"]
     kinds = set(schemas["alert"]["$defs"]["AlertKind"]["enum"])
     assert {"microsleep", "sleep", "drowsy", "unresponsive", "degraded"} <= kinds
     assert {"closure_s", "perclos", "reason"} <= set(schemas["alert"]["required"])
@@ -74,12 +76,12 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
         (
             "yaw",
             {"seq": 9, "t_s": 0.3, "yaw_deg": -12.34, "gaze": "on_road"},
-            "yaw    car-1 #9 t=0.30s   -12.3° on_road",
+            "yaw    car-1 #9      t=0.30s      -12.3° on_road",
         ),
         (
             "yaw",
             {"seq": 9, "t_s": 0.3, "yaw_deg": 1.0, "pitch_deg": -41.26, "zone": "lap"},
-            "yaw    car-1 #9 t=0.30s    +1.0° pitch   -41.3° lap",
+            "yaw    car-1 #9      t=0.30s       +1.0° pitch   -41.3° lap",
         ),
         (
             "yaw",
@@ -91,7 +93,7 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
                 "zone": None,
                 "gaze": "unknown",
             },
-            "yaw    car-1 #9 t=0.30s     --   pitch     --   unknown",
+            "yaw    car-1 #9      t=0.30s        --   pitch     --   unknown",
         ),
         (
             "yaw",
@@ -110,15 +112,15 @@ def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:
                 "perclos": 0.04,
                 "degraded": False,
             },
-            "yaw    car-1 #9 t=0.30s    -1.2° pitch   -11.1° centre_stack eyes open 0.17 "
+            "yaw    car-1 #9      t=0.30s       -1.2° pitch   -11.1° centre_stack eyes open 0.17 "
             "gaze -20.8°/-22.8° perclos 0.04",
         ),
         (
             "yaw",
             {"seq": 9, "t_s": 0.3, "yaw_deg": -1.0, "pitch_deg": -11.0, "zone": "road"}
             | {"eyes": "closed", "eye_openness": 0.02, "closure_s": 1.8, "degraded": True},
-            "yaw    car-1 #9 t=0.30s    -1.0° pitch   -11.0° road eyes closed 0.02 closed 1.8s "
-            "DEGRADED",
+            "yaw    car-1 #9      t=0.30s       -1.0° pitch   -11.0° road eyes closed 0.02 "
+            "closed 1.8s DEGRADED",
         ),
         (
             "alert",

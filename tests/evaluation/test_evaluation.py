@@ -193,6 +193,9 @@ def test_eye_report_counts_every_face_and_compares_gaze_with_head() -> None:
     text = format_eye_report(report)
     assert "open 3 (60.00%) (of which 1 looking down), closed 1 (20.00%), not judged 1" in text
     assert report.to_json_dict()["open_rate"] == pytest.approx(0.6)
+    # The open-eyed set leaves out tilt -60 (f1, open by the look-down rule).
+    assert report.open_eyed() == (4, 2, 1, 1)
+    assert "open-eyed (|tilt| <= 30): 4 faces, open 2 (50.00%), closed 1 (25.00%)" in text
 
 
 def test_pitch_report_rank_correlation_bias_and_lap() -> None:
@@ -413,3 +416,19 @@ def test_refit_does_not_get_worse(
     refit = refit_constants(truths, estimates)
     for entry in refit["models"].values():
         assert entry["refit_mae_deg"] <= entry["paper_mae_deg"] + 1e-9
+
+
+@needs_pointing04
+@pytest.mark.slow
+def test_full_range_holds_up_leaving_each_subject_out(
+    pointing04_run: tuple[list[GroundTruth], list[ImageEstimate], EvaluationReport],
+) -> None:
+    """The blend's constants re-fitted without the scored subject (docs/pose.md): within +-60 no
+    worse than Center-CE, over all poses well below it; every fold finds constants."""
+    _, _, report = pointing04_run
+    cv = report.cross_validation
+    assert cv is not None and len(cv.folds) == 10
+    assert all(fold.constants is not None for fold in cv.folds)
+    inner, every = cv.ranges["abs_yaw_le_60"], cv.ranges["all"]
+    assert inner["service_cv"].mae_deg < inner["center_ce"].mae_deg
+    assert every["service_cv"].mae_deg < every["center_ce"].mae_deg - 1.5

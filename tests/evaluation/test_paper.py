@@ -88,8 +88,8 @@ def test_paper_tables_command_prints_both_tables_and_writes_plots(
 ) -> None:
     assert main(["paper-tables", "--plots", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "Experiment 1" in out
-    assert "Experiment 2" in out
+    assert "Table III, Experiment 1" in out
+    assert "Table IV, Experiment 2" in out
     for model in YAW_MODELS:
         assert out.count(f"\n{model} ") == 2
     pngs = sorted(path.name for path in tmp_path.glob("*.png"))

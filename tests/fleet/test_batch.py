@@ -17,7 +17,7 @@ import pytest
 from roadgaze.cli import main
 from roadgaze.config import Config, load_config
 from roadgaze.fleet import Drive, DriveTask, find_done, output_paths
-from roadgaze.fleet.batch import batch_lock
+from roadgaze.fleet.batch import LOCK_NAME, batch_lock
 from roadgaze.outputs import RECORD_FIELDS
 
 pytestmark = pytest.mark.slow
@@ -69,8 +69,7 @@ def test_bad_files_are_recorded_with_their_error_and_do_not_stop_the_batch(
     assert rows["corrupt"]["status"] == "failed" and rows["corrupt"]["frames"] is None
     report = (local_batch.out_dir / "report.html").read_text()
     assert "is empty (0 bytes)" in report and "glance" in report
-    leftovers = [p for p in local_batch.out_dir.rglob(".*") if p.name != ".batch.lock"]
-    assert leftovers == []
+    assert list(local_batch.out_dir.rglob(".*")) == []  # the lock file too
 
 
 def test_summary_figures_agree_with_the_frames(local_batch: Any) -> None:
@@ -229,3 +228,34 @@ def test_a_folder_held_by_another_batch_is_refused(
     with batch_lock(tmp_path):
         code = main(["batch", str(local_batch.input.folder), "--out", str(tmp_path)])
     assert code == 2 and "another roadgaze batch is writing to" in capsys.readouterr().err
+
+
+def test_the_lock_file_goes_with_the_batch_and_a_stale_one_is_taken_over(tmp_path: Path) -> None:
+    stale = tmp_path / LOCK_NAME
+    stale.write_text("")  # what a kill -9 leaves
+    with batch_lock(tmp_path):
+        assert stale.exists()
+    assert not stale.exists()
+
+
+def test_a_batch_that_locked_a_removed_lock_file_takes_a_fresh_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The race of removing a lock file: B opened it, A removed it and left, B then locks the
+    removed file; B must notice and lock the path's file, or a third batch could run beside it."""
+    import roadgaze.fleet.batch as batch_module
+
+    real_flock = batch_module.fcntl.flock
+    calls = []
+
+    def flock_after_removal(descriptor: int, operation: int) -> None:
+        calls.append(descriptor)
+        if len(calls) == 1:
+            (tmp_path / LOCK_NAME).unlink()  # A removes the file between B's open and lock
+        real_flock(descriptor, operation)
+
+    monkeypatch.setattr(batch_module.fcntl, "flock", flock_after_removal)
+    with batch_lock(tmp_path):
+        held = os.fstat(calls[-1])
+        named = (tmp_path / LOCK_NAME).stat()
+        assert len(calls) == 2 and (held.st_ino, held.st_dev) == (named.st_ino, named.st_dev)

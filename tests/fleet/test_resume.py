@@ -76,7 +76,7 @@ def test_stop_kill_and_resume(synthetic_clip: Any, tmp_path: Path) -> None:
     _, err = stopped.communicate(timeout=120)
     assert stopped.returncode == 130, err
     assert "run the same command again to continue" in err and "Traceback" not in err
-    assert [p for p in out.rglob(".*") if p.name != ".batch.lock"] == []
+    assert list(out.rglob(".*")) == []  # the lock file too
     done_first = len(finished(out))
     assert 1 <= done_first < DRIVES
     assert_complete(out, len(truth))
@@ -100,7 +100,7 @@ def test_stop_kill_and_resume(synthetic_clip: Any, tmp_path: Path) -> None:
     assert figures["processed"] == DRIVES - done_second
     assert len(finished(out)) == DRIVES
     assert_complete(out, len(truth))
-    assert [p for p in out.rglob(".*") if p.name != ".batch.lock"] == []
+    assert list(out.rglob(".*")) == []  # the lock file too
 
 
 def test_a_worker_that_dies_fails_its_drive_after_the_retries_and_the_batch_goes_on(
@@ -114,3 +114,8 @@ def test_a_worker_that_dies_fails_its_drive_after_the_retries_and_the_batch_goes
     assert (results["ok1"].status, results["ok2"].status) == ("ok", "ok")
     assert results["crash"].status == "failed"
     assert "worker process died 2 times" in (results["crash"].error or "")
+    # Each death is said on stderr and in batch.log, and counted for the summary.
+    assert (engine.worker_deaths, engine.retried) == (2, 1)
+    batch_log = (tmp_path / "batch.log").read_text()
+    assert batch_log.count("a worker process died while running drive crash") == 2
+    assert "try 1 of 2" in batch_log and "giving up on it (--retries)" in batch_log

@@ -63,6 +63,7 @@ def test_group_figures_are_weighted_by_frames_and_time() -> None:
     assert alice.face_found_rate == pytest.approx((1800 + 450) / 2700)
     assert alice.off_road_ratio == pytest.approx((180 + 300) / (1800 + 600))
     eye_kinds = ("microsleep", "sleep", "drowsy", "unresponsive", "degraded")
+    eye_kinds += ("temporary_failure", "permanent_failure")  # alert/3's failure kinds
     assert alice.alerts == {
         "long_distraction": 3,
         "vats": 1,
@@ -115,3 +116,31 @@ def test_the_report_is_one_self_contained_escaped_page(tmp_path: Path) -> None:
     assert all(base64.b64decode(data).startswith(b"\x89PNG") for data in images)
     assert "cannot read video" in page and "alice" in page
     assert outcome.to_json()["frames"] == 1800 + 3600  # the resumed drive is not counted
+
+
+def test_the_bar_legend_sits_beside_the_bars_and_tables_fit_the_page() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from roadgaze.fleet.report import alerts_by_driver
+
+    figure, axes = plt.subplots(figsize=(9.0, 2.5), dpi=100)
+    try:
+        alerts_by_driver(axes, by_driver(RESULTS[:3]))
+        figure.tight_layout()
+        figure.canvas.draw()
+        legend = axes.get_legend().get_window_extent()
+        plot_area = axes.get_window_extent()
+        assert legend.x0 >= plot_area.x1  # not over the first bar
+        assert legend.x1 <= figure.bbox.x1 + 1  # and inside the image
+    finally:
+        plt.close(figure)
+    page = render_report(BatchOutcome(RESULTS, "local", 2, wall_s=30.0, startup_s=0.0))
+    tables = page.count("<table>")
+    assert tables == 3 and page.count('<div class="wide"><table>') == tables  # scroll, not clip
+    assert ".wide{overflow-x:auto" in page and "white-space:normal" in page  # heads wrap
+    # Kinds no drive raised take no columns (eight mostly empty columns made the tables too wide).
+    assert "No drive raised microsleep, sleep, drowsy, unresponsive, degraded" in page
+    assert "<th>microsleep /h</th>" not in page and "<th>vats /h</th>" in page

@@ -138,6 +138,7 @@ def test_the_recorder_counts_an_escalated_alert_once(tmp_path: Path) -> None:
         result = recorder.result(Drive("d1", tmp_path / "x.mp4"), 0.1, None, 50.0, 0.2)
         assert alert_writer.rows == 4
     eye_kinds = ("microsleep", "sleep", "drowsy", "unresponsive", "degraded")
+    eye_kinds += ("temporary_failure", "permanent_failure")  # alert/3's failure kinds
     assert dict(result.alert_counts) == {
         "long_distraction": 1,
         "vats": 1,

@@ -10,7 +10,7 @@ import pytest
 
 from repo_paths import POINTING04
 from roadgaze.config import EyesConfig
-from roadgaze.landmarks.eye_contrast import eye_contrast, polygon_mask
+from roadgaze.landmarks.eye_contrast import eye_contrast, eye_sharpness, polygon_mask
 from roadgaze.landmarks.eyes import (
     BLENDSHAPE_PITCH_PER_DEG,
     BLENDSHAPE_YAW_PER_DEG,
@@ -221,6 +221,33 @@ def test_eye_contrast_of_a_drawn_eye_and_a_dark_lens() -> None:
     assert math.isnan(eye_contrast(image[:10, :10], points, LEFT_EYE))
 
 
+def test_eye_sharpness_of_a_drawn_eye_blurred_and_flat() -> None:
+    import cv2
+
+    points = built_landmarks(aperture=0.4)
+    image = np.full((480, 640), 150, np.uint8)  # skin
+    for eye in EYES:
+        image[polygon_mask(points[list(eye.contour), :2], (480, 640))] = 230
+    sharp = eye_sharpness(image, points, RIGHT_EYE)
+    # A step of 80 grey levels gives a 3x3 Sobel magnitude of 4 x 80 on its edge pixels.
+    assert 1.0 < sharp <= 4 * 80 / 150 + 1e-6
+    blurred = cv2.GaussianBlur(image, (0, 0), 4.0)
+    assert eye_sharpness(blurred, points, RIGHT_EYE) < EyesConfig().min_sharpness < sharp
+    assert eye_sharpness(np.full((480, 640), 150, np.uint8), points, LEFT_EYE) == 0.0
+    assert math.isnan(eye_sharpness(image[:10, :10], points, LEFT_EYE))
+
+
+def test_eyes_without_sharp_edges_are_blurred() -> None:
+    points = built_landmarks(aperture=0.1)
+    assert eye_features(points, 0.0, sharpness=(0.3, 0.5)).blurred
+    assert eye_features(points, 0.0, sharpness=(0.3, math.nan)).blurred
+    assert not eye_features(points, 0.0, sharpness=(0.3, 0.9)).blurred
+    assert not eye_features(points, 0.0, sharpness=(math.nan, math.nan)).blurred
+    assert not eye_features(points, 0.0).blurred
+    off = EyesConfig(min_sharpness=0.0)
+    assert not eye_features(points, 0.0, sharpness=(0.0, 0.0), config=off).blurred
+
+
 @pytest.fixture(scope="module")
 def photo_face() -> object:
     from roadgaze.config import Config
@@ -237,6 +264,8 @@ def test_mediapipe_gives_blendshapes_and_open_visible_eyes(photo_face: object) -
     assert isinstance(photo_face, FaceFeatures)
     assert photo_face.blendshapes is not None and len(photo_face.blendshapes) == 52
     assert photo_face.eye_contrast is not None and min(photo_face.eye_contrast) > 0.3
+    assert photo_face.eye_sharpness is not None
+    assert min(photo_face.eye_sharpness) > EyesConfig().min_sharpness
     eyes = driver_eyes(photo_face, 0.0)
     assert eyes is not None and eyes.method == "blendshapes" and not eyes.occluded
     assert eyes.openness is not None and 0.25 < eyes.openness < 0.4
@@ -263,7 +292,7 @@ def test_mirror_average_keeps_the_eyes_symmetric() -> None:
         )
 
 
-@pytest.mark.skipif(not POINTING04.is_dir(), reason="needs ../shared/data/pointing04-dev")
+@pytest.mark.skipif(not POINTING04.is_dir(), reason="needs the Pointing'04 set ($ROADGAZE_DATA)")
 def test_iris_468_is_the_persons_right_eye_on_a_frontal_still() -> None:
     from roadgaze.config import Config
     from roadgaze.evaluation.images import read_image

@@ -3,6 +3,8 @@ PERCLOS against closed forms, gaze with its deadband, unavailable eyes and degra
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -90,7 +92,8 @@ def drive(
         (0.19, 0.60, 0.0, True, (EyeStatus.OPEN, "")),
         (0.05, 0.70, 12.0, False, (EyeStatus.OPEN, "looking down")),  # head lowered
         (0.05, 0.70, 12.0, True, (EyeStatus.CLOSED, "eyes closed")),  # closed before it dropped
-        (0.05, 0.70, 6.0, None, (EyeStatus.CLOSED, "eyes closed")),
+        (0.05, 0.70, 6.0, None, (EyeStatus.OPEN, "looking down")),  # beyond 4 deg
+        (0.05, 0.70, 3.0, None, (EyeStatus.CLOSED, "eyes closed")),
     ],
 )
 def test_closed_or_open(
@@ -247,3 +250,24 @@ def test_samples_out_of_order_are_ignored() -> None:
     state, _ = step_eyes(CONFIG, EyeMonitorState(), sample(1.0, eyes_of()), True, True, 0.0, 0.0)
     again, events = step_eyes(CONFIG, state, sample(0.5, eyes_of()), True, True, 0.0, 0.0)
     assert again is state and events == ()
+
+
+def test_lids_that_read_closed_on_blurred_eyes_are_not_judged() -> None:
+    blurred = replace(eyes_of(0.06, 0.7), blurred=True)
+    assert classify_eyes(CONFIG, blurred, 0.0) == (EyeStatus.UNAVAILABLE, "eyes blurred")
+    assert classify_eyes(CONFIG, replace(eyes_of(0.30), blurred=True), 0.0) == (EyeStatus.OPEN, "")
+    # once closed (a closure seen sharp), blur does not end it
+    assert classify_eyes(CONFIG, blurred, 0.0, was_closed=True)[0] is EyeStatus.CLOSED
+
+
+@pytest.mark.parametrize(("far_openness", "expected"), [(0.20, "eyes disagree"), (0.08, "")])
+def test_one_judged_eye_closes_only_if_the_other_does_not_read_open(
+    far_openness: float, expected: str
+) -> None:
+    both = eyes_of(0.06, 0.7)
+    far = replace(both.left, openness=far_openness, closure_usable=False, reason="far eye")
+    status, reason = classify_eyes(CONFIG, replace(both, left=far), 0.0)
+    if expected:
+        assert (status, reason) == (EyeStatus.UNAVAILABLE, expected)
+    else:
+        assert (status, reason) == (EyeStatus.CLOSED, "eyes closed")

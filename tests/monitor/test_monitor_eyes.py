@@ -14,7 +14,8 @@ from roadgaze.monitor import Alert, AlertKind, Monitor
 from roadgaze.types import EyesFeatures, EyeStatus, Gaze, PoseSample
 
 FPS = 15.0
-FIXED = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=0.0)
+FIXED = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=0.0, eye_calibration_s=1.5)
+"""Calibrated 1.5 s into the drive: before the glances of these tests start (at 2 s)."""
 
 Script = Callable[[float], tuple[float, EyesFeatures | None]]
 """Head yaw and the eyes at time t (eyes None: no face)."""

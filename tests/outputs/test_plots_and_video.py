@@ -3,6 +3,7 @@ overlap, alerts on screen until cleared, the gaze and the timers."""
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from pathlib import Path
 
@@ -14,7 +15,7 @@ from roadgaze.config import MonitorConfig
 from roadgaze.monitor import Monitor
 from roadgaze.outputs import PANEL_LINES, AlertBoard, YawPlot, annotate, label_rows
 from roadgaze.outputs.plots import road_bands_deg
-from roadgaze.types import Alert, AlertKind, AlertLevel, FrameRecord, PoseSample
+from roadgaze.types import Alert, AlertKind, AlertLevel, EyesVerdict, FrameRecord, PoseSample
 
 FIXED = MonitorConfig(neutral_yaw_deg=0.0, zones=[], driving_related_zones=[])
 """No zones but the road: any glance off it is a distraction."""
@@ -95,6 +96,41 @@ def test_plot_keeps_what_the_monitor_decided(tmp_path: Path) -> None:
     assert plot.neutral_deg == [0.0] * len(records)
     assert [a.kind for a in plot.alerts] == [AlertKind.LONG_DISTRACTION, AlertKind.CLEARED]
     assert len(plot.label_boxes) == 2
+
+
+def test_the_plot_draws_the_gaze_pitch_shares_equal_thresholds_and_names_empty_series(
+    tmp_path: Path,
+) -> None:
+    """The gaze pitch is what puts a frame in `lap`; long distraction and sleep are both 3 s
+    (one label, not two printed on top of each other); PERCLOS without a value says so."""
+    eyes = EyesVerdict(gaze_source="eyes", gaze_yaw_deg=2.0, gaze_pitch_deg=-30.0, openness=0.3)
+    records = [
+        dataclasses.replace(r, verdict=dataclasses.replace(r.verdict, eyes=eyes))
+        for r in monitored(FIXED, glance(4.0))
+    ]
+    with YawPlot(tmp_path / "yaw.png", monitor=FIXED) as plot:
+        for record in records:
+            plot.on_record(record, BLANK_FRAME)
+    assert plot.pitch_deg and "gaze pitch (eyes)" in plot.legend_labels["pitch"]
+    assert "PERCLOS (no value in this run)" in plot.legend_labels["eyes"]
+    assert "long distraction, sleep 3 s" in plot.threshold_texts
+    values = [text.rsplit(" ", 2)[-2] for text in plot.threshold_texts]
+    assert len(values) == len(set(values))  # one label per value
+
+
+def test_without_alerts_there_is_no_alert_strip(tmp_path: Path) -> None:
+    import matplotlib.image
+
+    with YawPlot(tmp_path / "quiet.png", monitor=FIXED) as quiet:
+        for record in monitored(FIXED, glance(1.0)):
+            quiet.on_record(record, BLANK_FRAME)
+    with YawPlot(tmp_path / "alerts.png", monitor=FIXED) as alerted:
+        for record in monitored(FIXED, glance(4.0)):
+            alerted.on_record(record, BLANK_FRAME)
+    assert quiet.alerts == [] and quiet.label_boxes == []
+    quiet_height = matplotlib.image.imread(tmp_path / "quiet.png").shape[0]
+    alerts_height = matplotlib.image.imread(tmp_path / "alerts.png").shape[0]
+    assert alerts_height - quiet_height == pytest.approx(1.1 * 110, abs=2)  # the strip, 1.1 in
 
 
 # ---------------------------------------------------------------- the annotated video

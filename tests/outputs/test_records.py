@@ -3,6 +3,7 @@ with the type its values have, so columnar writers derived from it lose nothing.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import pytest
@@ -82,3 +83,12 @@ def test_alert_fields_are_the_alert_message_without_its_wire_fields(alert: Alert
     wire_only = {"schema_id", "vehicle_id", "seq", "wall_time"}
     assert set(message) - wire_only == set(fields)
     assert {name: message[name] for name in fields} == fields
+
+
+def test_durations_are_floats_from_frame_0_even_when_the_monitor_gives_an_int() -> None:
+    """A window that sums no glance yet is `sum([]) == 0`, an int: the record still says 0.0."""
+    first = record_of(PoseSample(0.0, 0, True, 1.0, 1.0, 0.0, 1.0, FACE, 1))
+    verdict = dataclasses.replace(first.verdict, window_off_road_s=0, off_road_s=0)
+    fields = record_fields(record_of(first.sample, verdict))
+    assert type(fields["window_off_road_s"]) is float and fields["window_off_road_s"] == 0.0
+    assert type(fields["off_road_s"]) is float

@@ -281,7 +281,18 @@ def test_roadgaze_run_under_a_notify_socket_ready_watchdog_and_stopping_on_sigte
     )
     env.pop("WATCHDOG_PID", None)
     process = subprocess.Popen(
-        [sys.executable, "-m", "roadgaze", "run", "--source", str(clip), "--vehicle-id", "sd"],
+        [
+            sys.executable,
+            "-m",
+            "roadgaze",
+            "run",
+            "--source",
+            str(clip),
+            "--vehicle-id",
+            "sd",
+            "--set",
+            "zenoh.delivery_wait_s=0",
+        ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -297,6 +308,6 @@ def test_roadgaze_run_under_a_notify_socket_ready_watchdog_and_stopping_on_sigte
     finally:
         stop_process(process)
         fake.close()
-    assert code == 0
+    assert code in (0, 4)  # 4: an alert was raised, and nobody was connected to receive it
     assert fake.with_key("READY")[0][1]["STATUS"] == (f"monitoring {clip}: first frame processed")
     assert fake.with_key("STOPPING")[0][1]["STATUS"].startswith("stopping (SIGTERM) after ")

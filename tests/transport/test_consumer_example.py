@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 
@@ -43,3 +44,38 @@ def test_the_example_gets_history_then_live_alerts_and_refuses_forgeries() -> No
     assert lines == [f"long_distraction warning seq={seq} t=7.00s" for seq in range(4)]
     assert stderr.count("refused an alert") == 2 and "Traceback" not in stderr
     assert "```python\n" + EXAMPLE.read_text() in (REPO / "docs" / "zenoh.md").read_text()
+
+
+def test_the_example_started_before_the_router_waits_then_reports_gaps_and_intruders() -> None:
+    """Issue 27: it died with `zenoh.ZError: Unable to connect`; issue 24: gaps and second
+    publishers were not reported, totals never printed."""
+    port = free_port()
+    process = subprocess.Popen(
+        [sys.executable, str(EXAMPLE), "car-42", endpoint(port), "12"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        errors = LineReader(process, process.stderr)
+        errors.until("waiting for the router", 20.0)
+        config = ZenohConfig(vehicle_id="car-42", connect=[endpoint(port)])
+        with (
+            router(port),
+            ZenohLink(config, Keys.from_config(config)) as link,
+            ZenohLink(config, Keys.from_config(config)) as intruder,
+        ):
+            assert wait_for(lambda: link.status().connected, timeout_s=15.0)
+            assert wait_for(lambda: intruder.status().connected, timeout_s=15.0)
+            reader = LineReader(process)
+            link.publish_alert(alert_message(2, "car-42"))  # #0 and #1 never reached it
+            assert reader.next(20.0) == "long_distraction warning seq=2 t=7.00s"
+            intruder.publish_alert(alert_message(100, "car-42"))
+            said = errors.until("SUSPICIOUS: alert #100 from a second publisher", 10.0)
+            link.publish_alert(alert_message(3, "car-42"))
+            assert reader.next(10.0) == "long_distraction warning seq=3 t=7.00s"
+            process.send_signal(signal.SIGINT)
+            said += errors.until("foreign", 20.0)
+            process.wait(timeout=20)
+    finally:
+        stop_process(process)
+    assert "MISSED #0-#1" in said and not any("Traceback" in line for line in said)
+    assert said[-1] == "2 alerts, 2 missed, 0 rejected, 1 foreign"

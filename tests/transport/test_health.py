@@ -135,9 +135,11 @@ def test_state_is_degraded_while_the_eyes_have_been_unavailable_ten_seconds() ->
                 "eyes unavailable for 11 s (head turned): monitoring on head pose only"
             ]
             assert (state.monitor.eyes, state.monitor.gaze_source) == ("unavailable", "head")
+            assert state.monitor.eye_calibration == "none"  # nothing to learn from yet
             jsonschema.validate(json.loads(state.to_json_bytes()), SCHEMAS["state"])
     state = health.state_message()
     assert (state.status, state.problems, state.monitor.eyes) == ("running", [], "open")
+    assert state.monitor.eye_calibration == "calibrated"  # 4 s of open eyes on the road
     # Euro NCAP needs the eyes: unjudgeable eyes are also a temporary failure (alert/3)
     kinds = [a.kind for a in health.recent_alerts]
     assert kinds == ["degraded", "temporary_failure", "cleared"]

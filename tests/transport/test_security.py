@@ -294,3 +294,22 @@ def test_without_access_control_a_spoofed_speed_in_range_is_taken(
         anyone.put(keys.speed, b'{"kmh": 1e308}')
         time.sleep(0.2)
         assert speed.kmh() is None and speed.current()[1] == "invalid"
+
+
+def test_roadgaze_speed_publishes_with_the_speed_providers_file(
+    secured: tuple[dict[str, Path], int], daemon: tuple[ZenohLink, SpeedInput]
+) -> None:
+    bundle, _ = secured
+    _, speed = daemon
+    provider = subprocess.Popen(
+        [sys.executable, "-m", "roadgaze", "speed", "--kmh", "42.5", "--duration", "20",
+         "--vehicle-id", VEHICLE, "--zenoh-config", str(bundle["speed"])],
+        stderr=subprocess.PIPE, text=True, env=child_env(),
+    )  # fmt: skip
+    try:
+        assert wait_for(lambda: speed.kmh() == 42.5, timeout_s=15.0, every_s=0.1)
+    finally:
+        provider.terminate()
+        _, err = provider.communicate(timeout=30)
+    assert provider.returncode == 0, err
+    assert "speeds published, the last 42.5 km/h" in err and "Traceback" not in err

@@ -204,12 +204,14 @@ def measure_latency(
     port = free_local_port()
     publishing = demo_config(config, port)
     stamps = CaptureStamps(received_s, capacity=MAX_SAMPLES)
-    with bus_outputs(publishing, source_label, publish=True) as bus:
+    with contextlib.ExitStack() as stack:
+        # The subscriber closes after the service's session: a subscriber leaving first is a
+        # link going down to the service, which warns that alerts are held.
+        probes = stack.enter_context(contextlib.ExitStack())
+        bus = stack.enter_context(bus_outputs(publishing, source_label, publish=True))
         probe = YawLatencyProbe(subscriber_config(publishing, port), stamps)
-        try:
-            if not probe.wait_for_publisher(SUBSCRIBER_WAIT_S):
-                log.warning("the latency subscriber did not see the publisher in time")
-            sinks = (stamps, *bus.sinks, stamps.published_mark)
-            yield LatencyRig(sinks=sinks, probe=probe, stamps=stamps)
-        finally:
-            probe.close()
+        probes.callback(probe.close)
+        if not probe.wait_for_publisher(SUBSCRIBER_WAIT_S):
+            log.warning("the latency subscriber did not see the publisher in time")
+        sinks = (stamps, *bus.sinks, stamps.published_mark)
+        yield LatencyRig(sinks=sinks, probe=probe, stamps=stamps)

@@ -1,7 +1,7 @@
 """File sources: every frame of a video file or an image folder, and a looping replay of a file.
 
-A file source delivers every frame, with timestamps from the container (or `index / fps` for a
-folder), strictly increasing; nothing is dropped.
+A file source delivers every frame, with timestamps from the container checked by `TimeBase`
+(or `index / fps` for a folder), strictly increasing; nothing is dropped.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from roadgaze.capture.base import (
     as_bgr,
     finite_positive,
 )
+from roadgaze.capture.timebase import TimeBase, check_avi_rate, sane_fps
 from roadgaze.errors import SourceError
 from roadgaze.types import Frame
 
@@ -35,16 +36,21 @@ os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
 
 log = logging.getLogger(__name__)
 
+MIN_SIDE_PX = 2
+"""Smaller frames (a 1x1 video) cannot hold a face: refused at open, naming the video."""
 IMAGE_SUFFIXES = frozenset({".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp", ".ppm"})
 
 
 class VideoFileSource(SourceBase):
     """Every frame of a video file OpenCV/FFmpeg can read (animated GIF included).
 
-    `t_s` is the container's presentation time of each frame; a missing or non-increasing
-    container time is replaced by the previous time plus one nominal frame period. Raises
-    `SourceError` when the file is missing or holds no readable frame. A stream that ends before
-    the announced frame count is reported in `status` (truncated, with the stop point) and logged.
+    `t_s` is the container's presentation time of each frame, checked by `TimeBase`: once a
+    timestamp is missing, goes backwards, stalls or jumps far beyond the frame rate, frames are
+    timed by their index at the container's rate (said once, and in `status.message`); with no
+    usable rate either, iterating raises `SourceError`. Raises `SourceError` when the file is
+    missing, holds no readable frame or its frames are smaller than 2x2 pixels. A stream that
+    ends before the announced frame count is reported in `status` (truncated, with the stop
+    point) and logged.
     """
 
     def __init__(
@@ -57,6 +63,8 @@ class VideoFileSource(SourceBase):
         self.path = Path(path)
         if not self.path.is_file():
             raise SourceError(f"video file {self.path} not found; pass an existing video file")
+        if capture_factory is None:
+            check_avi_rate(self.path)
         factory = capture_factory or (lambda name: cv2.VideoCapture(name, cv2.CAP_FFMPEG))
         self._capture: VideoCaptureLike | None = factory(str(self.path))
         if not self._capture.isOpened():
@@ -70,14 +78,21 @@ class VideoFileSource(SourceBase):
         if not ok or first is None:
             self.close()
             raise SourceError(f"cannot read video {self.path}: it holds no readable frame")
+        if min(first.shape[:2]) < MIN_SIDE_PX:
+            self.close()
+            raise SourceError(
+                f"video {self.path} is {first.shape[1]}x{first.shape[0]} pixels: too small to "
+                f"hold a face (at least {MIN_SIDE_PX}x{MIN_SIDE_PX} needed)"
+            )
         self._first: npt.NDArray[np.uint8] | None = as_bgr(first)
         self._first_t_s = self._container_time_s()
         count = self._capture.get(cv2.CAP_PROP_FRAME_COUNT)
         height, width = first.shape[:2]
+        self._raw_fps = self._capture.get(cv2.CAP_PROP_FPS)
         self._info = SourceInfo(
             name=str(self.path),
             live=False,
-            fps=finite_positive(self._capture.get(cv2.CAP_PROP_FPS)),
+            fps=sane_fps(self._raw_fps),
             frame_count=int(count) if finite_positive(count) else None,
             width=int(width),
             height=int(height),
@@ -100,15 +115,17 @@ class VideoFileSource(SourceBase):
         if self._iterated:
             raise SourceError(f"video {self.path} can be iterated only once; open it again")
         self._iterated = True
-        period_s = 1.0 / (self._info.fps or 30.0)
+        time_base = TimeBase(str(self.path), self._raw_fps)
         index = 0
         previous_t_s: float | None = None
         image = self._first
-        t_s = self._first_t_s
+        container_t_s = self._first_t_s
         self._first = None
         while image is not None:
-            if t_s is None or (previous_t_s is not None and t_s <= previous_t_s):
-                t_s = 0.0 if previous_t_s is None else previous_t_s + period_s
+            t_s = time_base.t_s(index, container_t_s)
+            if time_base.flagged and self._status.message is None:
+                message = f"video {self.path}: {time_base.fallback_reason}: frame-index time used"
+                self._status = replace(self._status, message=message)
             self._status = replace(self._status, frames_delivered=index + 1)
             yield Frame(index=index, t_s=t_s, image=image)
             previous_t_s = t_s
@@ -119,14 +136,14 @@ class VideoFileSource(SourceBase):
             if not ok or raw is None:
                 break
             image = as_bgr(raw)
-            t_s = self._container_time_s()
+            container_t_s = self._container_time_s()
         self._finish(index, previous_t_s)
 
     def _finish(self, delivered: int, last_t_s: float | None) -> None:
         expected = self._info.frame_count
         # Containers round their frame count; only a clear shortfall means truncation.
         truncated = expected is not None and delivered < expected - max(1, expected // 100)
-        message = None
+        message = self._status.message
         if truncated:
             message = (
                 f"video {self.path} ended early: read {delivered} of {expected} announced frames, "

@@ -137,7 +137,7 @@ class McapSource(SourceBase):
     def _read_frames(self) -> Iterator[tuple[CameraImage, int]]:
         """(frame, log time) of each camera message in file order, until the end or the first
         unreadable record (a recording cut short)."""
-        from mcap.records import Channel, Message, Metadata, Schema
+        from mcap.records import Channel, Footer, Message, Metadata, Schema
         from mcap.stream_reader import StreamReader
 
         assert self._handle is not None
@@ -152,6 +152,11 @@ class McapSource(SourceBase):
                 self._cut(exc)
                 return
             if record is None:
+                # Ended between two records without the footer: the writer never closed it
+                # (`kill -9` or a power loss after a whole chunk), so it is cut short too.
+                self._truncation = self._truncation or "no footer after the last complete record"
+                return
+            if isinstance(record, Footer):
                 return
             if isinstance(record, Schema):
                 schemas[record.id] = record

@@ -6,6 +6,7 @@ from roadgaze.commands import (
     batch,
     bench,
     conformance,
+    data,
     demo,
     doctor,
     estimate,
@@ -19,6 +20,7 @@ from roadgaze.commands import (
     run,
     schema,
     security,
+    speed,
     synth,
 )
 
@@ -26,6 +28,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     demo,
     run,
     listen,
+    speed,
     router,
     replay,
     batch,
@@ -33,6 +36,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     recover,
     bench,
     evaluate,
+    data,
     estimate,
     synth,
     model,

@@ -64,6 +64,14 @@ def register(subparsers: Any) -> None:
         "RAY_ADDRESS, else a local Ray instance",
     )
     parser.add_argument(
+        "--ray-timeout",
+        type=float,
+        default=30.0,
+        metavar="S",
+        help="fail (exit 2, naming the address) when no Ray cluster answers at the address in S "
+        "seconds (default 30)",
+    )
+    parser.add_argument(
         "--hash",
         action="store_true",
         help="recognise unchanged inputs by their SHA-256 instead of size and modification time",
@@ -98,6 +106,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
         raise ConfigError(f"--workers must be at least 1, found {args.workers}")
     if args.retries < 0:
         raise ConfigError(f"--retries must be 0 or more, found {args.retries}")
+    if not 0 < args.ray_timeout <= 3600:
+        raise ConfigError(f"--ray-timeout must be within 0-3600 s, found {args.ray_timeout:g}")
     if args.speed_kmh is not None:
         from roadgaze.capture.speed_track import recorded_speed
 
@@ -117,6 +127,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
         engine=args.engine,
         workers=args.workers,
         ray_address=args.ray_address,
+        ray_timeout_s=args.ray_timeout,
         content_hash=args.hash,
         retries=args.retries,
         progress=not args.no_progress,
@@ -149,6 +160,12 @@ def report(outcome: BatchOutcome, out_dir: Path) -> None:
         outcome.workers,
         "" if outcome.workers == 1 else "s",
     )
+    if figures["worker_deaths"]:
+        log.warning(
+            "batch: %s worker process deaths, %s drives tried again (see batch.log)",
+            figures["worker_deaths"],
+            figures["retries"],
+        )
     for result in outcome.failed[:FAILED_LISTED]:
         log.warning("batch: failed %s (%s): %s", result.drive_id, result.path, result.error)
     if len(outcome.failed) > FAILED_LISTED:

@@ -82,6 +82,12 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--record", action="store_true", help="add --repeat rounds of passes "
                         "without a recorder, recording records and alerts to MCAP, and camera "
                         "frames too; report the cost per frame (roadgaze[foxglove])")  # fmt: skip
+    parser.add_argument(
+        "--engines",
+        action="store_true",
+        help="compare the landmark engines: --repeat rounds of a raw FaceLandmarker pass and one "
+        "pipeline pass per engine (litert, mediapipe), interleaved; medians and the load average",
+    )
     parser.set_defaults(handler=run)
 
 
@@ -120,10 +126,13 @@ class PassResult:
     """After the warm-up (`ThroughputProbe`)."""
     cpu_ms_per_frame: float | None
     median_interval_ms: float | None
+    engine: str | None = None
+    """The landmark engine that ran."""
 
 
 def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.benchmark import MemoryProbe, resident_mb
+    from roadgaze.benchmark.report import format_result
     from roadgaze.errors import ConfigError
     from roadgaze.pipeline import StageTimings
 
@@ -136,6 +145,8 @@ def run(args: argparse.Namespace, config: Config) -> int:
         from roadgaze.outputs.foxglove import require_foxglove
 
         require_foxglove("bench --record")
+    if args.engines:
+        return engines_run(args, config)
     rss_start_mb = resident_mb()
     with open_bench_source(args, config) as first_source:
         live = first_source.info.live
@@ -181,6 +192,29 @@ def run(args: argparse.Namespace, config: Config) -> int:
     return 0
 
 
+def engines_run(args: argparse.Namespace, config: Config) -> int:
+    """`--engines`: both engines and raw FaceLandmarker, interleaved (`benchmark.engines`)."""
+    from roadgaze.benchmark.engines import EnginePass, compare_engines, format_engines
+    from roadgaze.pipeline import StageTimings
+
+    def engine_pass(name: str) -> EnginePass:
+        landmarks = config.landmarks.model_copy(update={"engine": name})
+        timings = StageTimings(skip_first=args.warmup)
+        result = pipeline_pass(
+            args, config.model_copy(update={"landmarks": landmarks}), [], timings
+        )
+        stages = {stage: (s.median_ms, s.p99_ms) for stage, s in timings.stats().items()}
+        return EnginePass(result.fps, result.cpu_ms_per_frame, stages, result.engine or name)
+
+    raws = iter(range(1, args.repeat + 2))
+    result = compare_engines(
+        args.repeat, engine_pass, lambda: raw_pass(args, config, next(raws), args.repeat + 1)
+    )
+    result = {"source": args.source, "default_engine": config.landmarks.engine, **result}
+    print(json.dumps(result) if args.json else "\n".join(format_engines(result)))
+    return 0
+
+
 def pipeline_pass(
     args: argparse.Namespace,
     config: Config,
@@ -202,7 +236,11 @@ def pipeline_pass(
         log.info("pipeline pass over %s%s", args.source, " at its frame rate" if realtime else "")
         summary = pipeline.run(source, [*sinks, throughput], timings=timings, realtime=realtime)
     return PassResult(
-        summary, throughput.fps, throughput.cpu_ms_per_frame, throughput.median_interval_ms
+        summary,
+        throughput.fps,
+        throughput.cpu_ms_per_frame,
+        throughput.median_interval_ms,
+        getattr(detector, "engine", None),
     )
 
 
@@ -342,57 +380,3 @@ def bench_result(
 def _median(values: Sequence[float | None]) -> float | None:
     known = [value for value in values if value is not None]
     return float(statistics.median(known)) if known else None
-
-
-def format_result(result: dict[str, Any]) -> str:
-    """The human-readable table of a bench result."""
-    lines = [
-        f"bench {result['source']}: {result['frames']} frames ({result['frames_timed']} timed)",
-        f"{'stage':<10} {'median ms':>10} {'p99 ms':>10}",
-    ]
-    for stage, stats in result["stages"].items():
-        lines.append(f"{stage:<10} {stats['median_ms']:>10.3f} {stats['p99_ms']:>10.3f}")
-    lines.append(
-        f"fps            {result['fps']:.1f} (after the warm-up: {result['pipeline_fps']})"
-    )
-    lines.append(f"overhead_ratio {result['overhead_ratio']:.3f}")
-    if result["raw_mediapipe_fps"] is not None:
-        raw = result["raw_mediapipe"]
-        lines.append(
-            f"raw MediaPipe  {result['raw_mediapipe_fps']:.1f} fps (passes "
-            f"{', '.join(str(fps) for fps in raw['passes_fps'])}; median {raw['median_ms']} ms)"
-        )
-        lines.append(
-            f"ratio_to_raw   {result['ratio_to_raw']} (per pass: "
-            f"{', '.join(str(ratio) for ratio in raw['ratios'])})"
-        )
-        lines.append(
-            f"cpu ms/frame   {result['cpu_ms_per_frame']} (raw {raw['cpu_ms_per_frame']}; "
-            f"cpu_ratio_to_raw {raw['cpu_ratio_to_raw']})"
-        )
-        lines.append(f"median_ratio_to_raw {raw['median_ratio_to_raw']} (median frame times)")
-    if "latency" in result:
-        latency = result["latency"]
-        lines.append(
-            f"latency        p50 {latency['p50_ms']} ms, p99 {latency['p99_ms']} ms, max "
-            f"{latency['max_ms']} ms ({latency['received']} of {latency['published']} received; "
-            f"target p99 <= {latency['target_p99_ms']} ms: "
-            f"{'met' if latency['meets_target'] else 'not met'})"
-        )
-        lines.append(
-            f"  of which   to publish p50 {latency['to_publish_p50_ms']} / p99 "
-            f"{latency['to_publish_p99_ms']} ms, Zenoh delivery p50 {latency['delivery_p50_ms']} / "
-            f"p99 {latency['delivery_p99_ms']} ms"
-        )
-    if "recording" in result:
-        from roadgaze.benchmark.recording import format_recording
-
-        lines += format_recording(result["recording"])
-    if "memory" in result:
-        memory = result["memory"]
-        lines.append(
-            f"memory: start {memory['rss_start_mb']} MiB, baseline {memory['rss_baseline_mb']} "
-            f"MiB, end {memory['rss_end_mb']} MiB, peak {memory['rss_peak_mb']} MiB, "
-            f"growth {memory['rss_growth_mb']} MiB"
-        )
-    return "\n".join(lines)

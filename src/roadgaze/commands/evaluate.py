@@ -19,14 +19,23 @@ def register(subparsers: Any) -> None:
         parents=[common_options()],
         help="score the yaw models against a data set's ground_truth.csv",
         description="Estimate the pose on every image listed in DATASET_DIR/ground_truth.csv "
-        "(columns file,yaw_deg[,pitch_deg]; rows with |pitch_deg| = 90 are skipped) and print "
-        "MAE, RMSE, median error and detection rate per yaw model, for the service's yaw and for "
-        "MediaPipe's own yaw, for |yaw| <= 60 deg, for all rows, and per 15 deg bin; with pitch "
-        "labels also the pitch's rank correlation and mean error per tilt and the lap "
-        "classification (tilt -60 against |tilt| <= 15). Stills take neutral 0. The report goes "
+        "(columns file,yaw_deg[,pitch_deg][,subject]; rows with |pitch_deg| = 90 are skipped) and "
+        "print MAE, RMSE, median error and detection rate per yaw model, for the service's yaw and "
+        "for MediaPipe's own yaw, for |yaw| <= 60 deg, for all rows, and MAE and bias per 15 deg "
+        "bin; with a subject column also the full-range blend with its constants re-fitted "
+        "leaving each subject out; with pitch labels also the pitch's rank correlation and mean "
+        "error per tilt and the lap classification (tilt -60 against |tilt| <= 15). Stills take "
+        "neutral 0. The report goes "
         "to stdout, the progress bar and the log to stderr.",
     )
-    parser.add_argument("dataset", type=Path, metavar="DATASET_DIR")
+    parser.add_argument(
+        "dataset",
+        type=Path,
+        nargs="?",
+        metavar="DATASET_DIR",
+        help="the folder with ground_truth.csv (default: $ROADGAZE_DATA/pointing04-dev; "
+        "`roadgaze data pointing04` builds one from the public archive)",
+    )
     parser.add_argument("--report", type=Path, metavar="JSON", help="write all figures as JSON")
     parser.add_argument(
         "--predictions", type=Path, metavar="CSV", help="write per-image estimates as CSV"
@@ -74,9 +83,17 @@ def run(args: argparse.Namespace, config: Config) -> int:
         write_predictions,
         write_report,
     )
+    from roadgaze.evaluation.pointing04 import DATA_ENV, default_dataset
     from roadgaze.landmarks import CANDIDATE_CHOICES
     from roadgaze.landmarks.model_store import resolve_model
 
+    if args.dataset is None:
+        args.dataset = default_dataset()
+        if args.dataset is None:
+            raise DatasetError(
+                f"no DATASET_DIR given and {DATA_ENV} is not set; pass the folder with "
+                "ground_truth.csv (`roadgaze data pointing04 SRC OUT` builds one)"
+            )
     check_output_paths(
         {"DATASET_DIR": args.dataset, "ground_truth.csv": args.dataset / "ground_truth.csv"},
         {

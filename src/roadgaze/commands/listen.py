@@ -18,6 +18,7 @@ import sys
 import time
 from typing import Any
 
+from roadgaze.commands.listen_alerts import AlertBook
 from roadgaze.commands.listen_lines import format_pretty as format_pretty
 from roadgaze.commands.listen_lines import format_vss as format_vss
 from roadgaze.commands.options import (
@@ -28,11 +29,17 @@ from roadgaze.commands.options import (
 )
 from roadgaze.config import Config
 from roadgaze.transport.checks import vehicle_of
+from roadgaze.transport.session import unreachable_hint
 
 log = logging.getLogger("roadgaze.listen")
 QUEUE_SIZE = 10_000
 VSS_MAX_BYTES = 256
 """A VSS value is a short text; anything longer is refused unread."""
+LEFT_HOLD_S = 0.5
+"""An `alive ... left` waits this long for the vehicle's final state, printed before it."""
+ALIVE_HISTORY_S = 0.5
+"""At start, how long the liveliness history may take before alerts are subscribed (so a
+running daemon's `alive ... joined` comes before its cached alerts)."""
 
 
 def register(subparsers: Any) -> None:
@@ -90,7 +97,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     endpoints = ", ".join(plan.connect + plan.listen) or "no endpoint"
     timeout_s = args.timeout if args.timeout is not None else 5.0 if args.query_state else None
     stop = StopFlag()
-    with signal_handlers(stop, doing="stopping"):
+    with signal_handlers(stop, doing="stopping", log_name=log.name):
         started = time.monotonic()
         log.info("roadgaze listen: %s; keys %s/*", plan.describe(), keys.prefix)
         if all_vehicles and plan.config_file is not None:
@@ -107,13 +114,10 @@ def run(args: argparse.Namespace, config: Config) -> int:
                 return 0
             if timeout_s is None:
                 raise
-            _say(
-                f"connected to nothing ({endpoints}) in {timeout_s:g} s: is `roadgaze run` "
-                "or a router up?"
-            )
+            _say(f"connected to nothing ({endpoints}) in {timeout_s:g} s: {unreachable_hint(plan)}")
             return 1
         with session:
-            listener = _Listener(args, zconf.prefix, keys, session, zconf.alert_cache_size)
+            listener = _Listener(args, zconf.prefix, keys, session, zconf.alert_cache_size, plan)
             if zconf.vss:
                 listener.vss_prefix = zconf.vss_prefix
             remaining_s = None if timeout_s is None else timeout_s - (time.monotonic() - started)
@@ -129,7 +133,13 @@ class _Listener:
     """The subscriptions of one `listen` run and the printing of what they receive."""
 
     def __init__(
-        self, args: argparse.Namespace, prefix_template: str, keys: Any, session: Any, history: int
+        self,
+        args: argparse.Namespace,
+        prefix_template: str,
+        keys: Any,
+        session: Any,
+        history: int,
+        plan: Any = None,
     ) -> None:
         import zenoh
 
@@ -137,6 +147,7 @@ class _Listener:
         from roadgaze.transport.checks import MessageChecker
 
         self.args = args
+        self.plan = plan
         self.keys = keys
         self.session = session
         self.prefix_template = prefix_template
@@ -150,6 +161,10 @@ class _Listener:
         self.connected: set[str] = set()
         self.ever_connected = False
         self.warn = ThrottledWarning(log, "roadgaze listen: message rejected", period_s=5.0)
+        self.book = AlertBook()
+        self._left: dict[str, tuple[float, str, dict[str, Any]]] = {}
+        """Vehicle -> (deadline, key, payload) of an `alive ... left` held for its final state."""
+        self._alive_seen = False
         self.vss_prefix: str | None = None
         """With --vss: the prefix of the VSS keys ('' for the bare paths); None: not shown."""
         self._sample_kind_put = zenoh.SampleKind.PUT
@@ -191,6 +206,7 @@ class _Listener:
 
     def _on_alive(self, sample: Any) -> None:
         alive = sample.kind == self._sample_kind_put
+        self._alive_seen = True
         self._emit("alive", str(sample.key_expr), json.dumps({"alive": alive}).encode())
 
     def _on_miss(self, miss: Any) -> None:
@@ -200,6 +216,13 @@ class _Listener:
         from zenoh.ext import HistoryConfig, RecoveryConfig, declare_advanced_subscriber
 
         session, keys = self.session, self.keys
+        # Liveliness first: a running daemon's `joined` is printed before its cached alerts.
+        self.entities.append(
+            session.liveliness().declare_subscriber(keys.alive, self._on_alive, history=True)
+        )
+        alive_deadline = time.monotonic() + ALIVE_HISTORY_S
+        while not self._alive_seen and time.monotonic() < alive_deadline and not stop.is_set():
+            time.sleep(0.02)
         alerts = declare_advanced_subscriber(
             session,
             keys.alert,
@@ -212,9 +235,6 @@ class _Listener:
         self.entities.append(session.declare_subscriber(keys.state, self._on_sample))
         if not self.args.no_yaw:
             self.entities.append(session.declare_subscriber(keys.yaw, self._on_sample))
-        self.entities.append(
-            session.liveliness().declare_subscriber(keys.alive, self._on_alive, history=True)
-        )
         if self.vss_prefix is not None:
             from roadgaze.transport import vss_key
 
@@ -224,7 +244,10 @@ class _Listener:
         deadline = None if timeout_s is None else time.monotonic() + timeout_s
         printed = 0
         while not stop.is_set() and (self.args.count is None or printed < self.args.count):
+            printed += self._release_left(time.monotonic())
             wait_s = 0.2 if deadline is None else min(0.2, deadline - time.monotonic())
+            if self._left:
+                wait_s = min(wait_s, 0.05)
             if wait_s <= 0:
                 break
             try:
@@ -232,13 +255,15 @@ class _Listener:
             except queue.Empty:
                 continue
             printed += self._print(kind, key, data, source)
-        if self.dropped:
-            _say(f"{self.dropped} messages dropped (printing too slow)")
+        printed += self._release_left(math.inf)
+        for line in self.book.unmatched_misses():
+            _say(line)
+        _say(self.book.totals(self.dropped))
         if printed == 0 and timeout_s is not None and not stop.is_set():
             if not self.ever_connected:
                 _say(
-                    f"connected to nothing ({endpoints}) in {timeout_s:g} s: is `roadgaze run` "
-                    "or a router up?"
+                    f"connected to nothing ({endpoints}) in {timeout_s:g} s: "
+                    f"{unreachable_hint(self.plan)}"
                 )
             else:
                 _say(
@@ -255,30 +280,64 @@ class _Listener:
             return self._print_vss(key, data)
         vehicle = vehicle_of(key, self.prefix_template)
         if kind == "missed":
-            _say(
-                f"MISSED {data!r} alerts of {vehicle}: lost before this listener could recover "
-                "them (older than the daemon's zenoh.alert_cache_size)"
-            )
+            self.book.on_zenoh_miss(str(source), int(data))
             return 0
         if isinstance(data, int):
+            self.book.rejected += 1
             self.warn(f"{kind} on {printable(key, 80)}: {data} bytes, limit {self.max_bytes}")
             return 0
         if kind == "alive":
             payload: dict[str, Any] = json.loads(data)
+            self.book.on_alive(vehicle, bool(payload["alive"]))
+            if not payload["alive"]:  # printed after the vehicle's final state, if it comes
+                self._left[vehicle] = (time.monotonic() + LEFT_HOLD_S, key, payload)
+                return 0
+            self._left.pop(vehicle, None)
         else:
             try:
                 checked = self.checker.check(kind, key, data, source)
             except PayloadError as exc:
+                self.book.rejected += 1
                 self.warn(f"{kind} on {printable(key, 80)}: {printable(str(exc))}")
                 return 0
             payload = checked.payload
-            if checked.missing_before:
-                _say(
-                    f"GAP: {checked.missing_before} alerts of {vehicle} missing before #"
-                    f"{payload['seq']}"
-                )
+            if kind == "alert" and not self._own_alert(checked, vehicle, source):
+                return 0
         self._show(kind, key, vehicle, payload)
+        if kind == "state" and vehicle in self._left:
+            return 1 + self._release_left(math.inf, vehicle)
         return 1
+
+    def _own_alert(self, checked: Any, vehicle: str, source: str | None) -> bool:
+        """False (after saying why) for an alert of another publisher; reports a gap before it."""
+        payload = checked.payload
+        seq = payload["seq"]
+        foreign = self.book.foreign_source(vehicle, source)
+        if foreign is not None:
+            self.book.foreign += 1
+            _say(
+                f"SUSPICIOUS alert #{seq} {payload['kind']} {payload['level']} of {vehicle} from "
+                f"{foreign}: not printed (another process publishes this vehicle's alerts; see "
+                "docs/security.md)"
+            )
+            return False
+        gap = self.book.gap(vehicle, str(source), seq, checked.missing_before, checked.first)
+        if gap is not None:
+            _say(gap)
+        self.book.printed += 1
+        return True
+
+    def _release_left(self, now: float, only: str | None = None) -> int:
+        """Print the held `alive ... left` lines whose wait is over (or `only`'s); count them."""
+        due = [
+            vehicle
+            for vehicle, (deadline, _, _) in self._left.items()
+            if (only is None or vehicle == only) and deadline <= now
+        ]
+        for vehicle in due:
+            _, key, payload = self._left.pop(vehicle)
+            self._show("alive", key, vehicle, payload)
+        return len(due)
 
     def _print_vss(self, key: str, data: bytes | int) -> int:
         from roadgaze.transport import PayloadError, parse_vss_text, printable
@@ -305,52 +364,9 @@ class _Listener:
 
     def query_state(self, timeout_s: float) -> int:
         """Ask every state queryable (no consolidation: a second answerer is seen) and print."""
-        import zenoh
+        from roadgaze.commands.listen_query import query_state
 
-        from roadgaze.transport import PayloadError, printable
-
-        deadline = time.monotonic() + timeout_s
-        answers: dict[str, list[str]] = {}
-        rejected = 0
-        while not answers and time.monotonic() < deadline:
-            # Right after opening, the routes to the queryable may not be known yet: ask again.
-            wait_s = max(0.05, min(1.0, deadline - time.monotonic()))
-            replies = self.session.get(
-                self.keys.state,
-                timeout=wait_s,
-                target=zenoh.QueryTarget.ALL,
-                consolidation=zenoh.ConsolidationMode.NONE,
-            )
-            for reply in replies:
-                if reply.ok is None:
-                    continue
-                key = str(reply.ok.key_expr)
-                try:
-                    checked = self.checker.check("state", key, reply.ok.payload.to_bytes())
-                except PayloadError as exc:
-                    _say(f"state answer on {printable(key, 80)} rejected: {printable(str(exc))}")
-                    rejected += 1
-                    continue
-                answers.setdefault(checked.vehicle_id, []).append(str(checked.payload["status"]))
-                self._show("state", key, checked.vehicle_id, checked.payload)
-        if not answers:
-            _say(f"no answer from {self.keys.state}")
-            return 1
-        twice = {vehicle: n for vehicle, statuses in answers.items() if (n := len(statuses)) > 1}
-        if twice:
-            _say(
-                f"suspicious: several answers for one vehicle {twice}: another process answers "
-                "on its state key (see docs/security.md)"
-            )
-            return 3
-        if rejected:
-            _say(
-                f"suspicious: {rejected} answer(s) rejected beside the valid one: another process "
-                "answers on the state key (see docs/security.md)"
-            )
-            return 3
-        statuses = [status for found in answers.values() for status in found]
-        return 0 if all(status == "running" for status in statuses) else 3
+        return query_state(self, timeout_s)
 
     def close(self) -> None:
         for entity in reversed(self.entities):

@@ -30,7 +30,9 @@ def format_pretty(kind: str, vehicle: str, payload: dict[str, Any] | None, raw: 
     if kind == "yaw":
         yaw = payload.get("yaw_deg")
         yaw_text = "    --  " if yaw is None else f"{yaw:+7.1f}°"
-        line = f"yaw    {vehicle} #{payload.get('seq')} t={payload.get('t_s', 0.0):.2f}s {yaw_text}"
+        # Fixed widths: the columns stay aligned from #10 and t=10 s on.
+        seq, t_text = f"#{payload.get('seq')}", f"t={payload.get('t_s', 0.0):.2f}s"
+        line = f"yaw    {vehicle} {seq:<7} {t_text:<10} {yaw_text}"
         if "zone" not in payload:  # roadgaze.yaw/1
             return f"{line} {payload.get('gaze')}"
         pitch = payload.get("pitch_deg")
@@ -41,9 +43,16 @@ def format_pretty(kind: str, vehicle: str, payload: dict[str, Any] | None, raw: 
         return f"{line} {_eyes_text(payload)}"
     if kind == "state":
         transport = payload.get("transport", {})
+        # alerts_sent counts only alerts published while a link was up; those published while
+        # it was down (held, then recovered from the cache) and those lost are counted apart.
+        delivery = f"alerts_sent={transport.get('alerts_sent')}"
+        if "alerts_held_while_down" in transport:
+            delivery += f" held={transport.get('alerts_held_while_down')}"
+        if "alerts_lost" in transport:
+            delivery += f" lost={transport.get('alerts_lost')}"
         return (
             f"state  {vehicle} status={payload.get('status')} frames={payload.get('frames')} "
-            f"alerts_sent={transport.get('alerts_sent')} problems={payload.get('problems')}"
+            f"{delivery} problems={payload.get('problems')}"
         )
     return f"{kind:<6} {vehicle} {raw[:200]}"
 

@@ -49,8 +49,10 @@ def register(subparsers: Any) -> None:
         parents=[common_options()],
         help="check the explicit and cached model files against size and SHA-256",
         description="Check the explicit model file (when set) and the cached one against the "
-        "expected size (3,758,596 bytes) and SHA-256, one line each on stdout; exit 0 when at "
-        "least one is valid, 1 otherwise.",
+        "expected size (3,758,596 bytes) and SHA-256, one line each on stdout; exit 0 when one "
+        "is valid and none is damaged (a missing cache beside a valid explicit file is fine), "
+        "1 when a file is damaged (wrong size or SHA-256), the explicit file is missing or none "
+        "is valid.",
     )
     verify.set_defaults(handler=run_verify)
 
@@ -103,9 +105,13 @@ def run_verify(args: argparse.Namespace, config: Config) -> int:
     explicit = explicit_model_path(model)
     if explicit is not None:
         candidates.insert(0, ("explicit", explicit))
-    good = False
+    good = damaged = False
     for label, candidate in candidates:
         problem = check_file(candidate)
         good = good or problem is None
+        # A cache not filled yet is not damage; a damaged file or a missing explicit one is.
+        damaged = damaged or (
+            problem is not None and (label == "explicit" or problem != "not found")
+        )
         print(f"{label}: {candidate}: {'ok' if problem is None else problem}")
-    return 0 if good else 1
+    return 0 if good and not damaged else 1

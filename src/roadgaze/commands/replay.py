@@ -90,7 +90,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--publish",
         action="store_true",
-        help="publish yaw, alerts, liveliness and state on Zenoh, stamped with the video's time",
+        help="publish yaw, alerts, liveliness and state on Zenoh, stamped with the video's time "
+        "(exit 4 when some alerts never reached the bus, each named)",
     )
     add_speed_options(parser)
     add_zenoh_options(parser)
@@ -233,6 +234,10 @@ def run(args: argparse.Namespace, config: Config) -> int:
         summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
     fill_offline(args, config)
     report(args, summary, stats)
+    if bus.undelivered():
+        from roadgaze.daemon import EXIT_UNDELIVERED
+
+        return EXIT_UNDELIVERED  # the warning naming them was logged when the link closed
     return 0
 
 

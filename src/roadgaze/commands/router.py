@@ -44,9 +44,10 @@ def run(args: argparse.Namespace, config: Config) -> int:
 
     stop = StopFlag()
     # Before zenoh is imported: a stop asked for during start-up is kept.
-    with signal_handlers(stop, doing="stopping the router"):
-        from roadgaze.transport.router import Router, RouterSettings
+    with signal_handlers(stop, doing="stopping the router", log_name="roadgaze.router"):
+        from roadgaze.transport.router import Router, RouterSettings, log_refused_handshakes
 
+        log_refused_handshakes()
         settings = RouterSettings(listen=tuple(args.listen or ()), config_file=args.zenoh_config)
         with Router(settings):
             while not stop.wait(1.0):

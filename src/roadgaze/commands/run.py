@@ -18,8 +18,10 @@ def register(subparsers: Any) -> None:
         description="Read a camera (/dev/videoN or an index) or a video file (paced at its own "
         "rate), estimate head yaw per frame, run the inattention monitor and publish on Zenoh "
         "under vehicle/<id>/dms/. SIGINT/SIGTERM/SIGHUP finish the current frame, publish a "
-        "final state, undeclare and exit 0. A lost camera and an unreachable Zenoh peer are "
-        "retried and reported in the state (degraded), never fatal.",
+        "final state, undeclare and exit 0 (a second signal: exit 1 at once). Exit 4 when some "
+        "alerts never reached the bus (no link before the end, after waiting "
+        "zenoh.delivery_wait_s; each is named). A lost camera and an unreachable Zenoh peer "
+        "are retried and reported in the state (degraded), never fatal.",
     )
     parser.add_argument(
         "--source", required=True, metavar="FILE|/dev/videoN|N", help="video file or camera"

@@ -39,6 +39,10 @@ class EyesConfig(Section):
     lids look open are taken as hidden (sunglasses); 0 turns the image check off."""
     occluded_min_openness: float = Field(default=0.18, ge=0)
     """The lids look open (so low contrast means a lens, not a closed lid) above this openness."""
+    min_sharpness: float = Field(default=0.65, ge=0)
+    """Eyes whose surroundings show weaker edges than this (relative to the skin below) in every
+    measured eye are blurred: lids that read closed there are not judged (unavailable, never
+    closed); 0 turns the check off."""
 
 
 class EyeMonitorSettings(Section):
@@ -53,7 +57,7 @@ class EyeMonitorSettings(Section):
     """Closed eyes count as open again only above this openness (hysteresis)."""
     eyes_blink_min: float = Field(default=0.4, ge=0, le=1)
     """The eyeBlink score that must agree between `eyes_hard_close_below` and `eyes_close_below`."""
-    look_down_head_deg: float = Field(default=8.0, gt=0)
+    look_down_head_deg: float = Field(default=4.0, gt=0)
     """Narrowed lids with the head this far below its road pitch (MediaPipe matrix pitch) read
     as looking down, not as closed."""
     gaze_deadband_deg: float = Field(default=10.0, ge=0)
@@ -63,6 +67,17 @@ class EyeMonitorSettings(Section):
     lower edge, so an eyes-only glance beyond 30 deg sideways or 20 deg down leaves it despite
     the deadband (with the default road)."""
     eye_neutral_limit_deg: float = Field(default=15.0, ge=0)
+    """The learned resting eye yaw is used within +-this (Pointing'04: per-subject resting yaw
+    -8..+17 deg, docs/eyes.md)."""
+    eye_neutral_pitch_limit_deg: float = Field(default=30.0, ge=0)
+    """The learned resting eye pitch is used within +-this (real faces read -26..+15 deg looking
+    ahead, docs/eyes.md)."""
+    eye_calibration_s: float = Field(default=3.0, gt=0)
+    """Open-eyed, on-road, steady-head time the driver's resting eye direction and its noise are
+    learned from before the eyes may move the gaze (until then the gaze is the head pose)."""
+    eye_noise_sigmas: float = Field(default=3.0, gt=0)
+    """The eyes move the gaze only beyond this many of the driver's measured standard deviations
+    of each axis (and never within `gaze_deadband_deg`)."""
     microsleep_s: float = Field(default=1.0, gt=0)
     sleep_s: float = Field(default=3.0, gt=0)
     unresponsive_closed_s: float = Field(default=6.0, gt=0)

@@ -104,6 +104,15 @@ class LandmarksConfig(_Section):
     mirror_average: bool = False
     """Also run the mirrored image and average the two measurements: exactly mirror-symmetric
     yaw and slightly better accuracy (docs/landmarks.md) for twice the landmarker time."""
+    engine: Literal["litert", "mediapipe"] = "mediapipe"
+    """What runs the face landmarker's models: `litert` (the three models on LiteRT with
+    MediaPipe's graph rebuilt around them, roadgaze.landmarks.engines) or `mediapipe` (its
+    FaceLandmarker, the reference). See docs/landmarks.md."""
+    threads: int = Field(default=1, ge=1, le=64)
+    """LiteRT's thread count per model (the `litert` engine; MediaPipe's API has none)."""
+    delegate: str = Field(default="xnnpack", min_length=1)
+    """LiteRT's delegate: `xnnpack` (its CPU kernels), `none` (builtin kernels, no delegate) or
+    the path of a delegate library, e.g. a vehicle NPU's from `ai-edge-litert-sdk-*`."""
 
 
 class CaptureConfig(_Section):
@@ -181,6 +190,9 @@ class MonitorConfig(EyeMonitorSettings, ProtocolSettings):
     neutral_time_constant_s: float = Field(default=60.0, gt=0)
     neutral_limit_deg: float = Field(default=20.0, ge=0)
     neutral_pitch_limit_deg: float = Field(default=20.0, ge=0)
+    neutral_max_rate_dps: float | None = Field(default=60.0, gt=0)
+    """A head turning faster than this (smoothed yaw rate) is passing through, not looking at
+    the road: it teaches neither the neutral pose nor the eye calibration; None: no limit."""
     long_distraction_s: float = Field(default=3.0, gt=0)
     critical_distraction_s: float = Field(default=6.0, gt=0)
     vats_window_s: float = Field(default=30.0, gt=0)

@@ -52,6 +52,9 @@ class ZenohConfig(Section):
     reconnect_initial_s: float = Field(default=0.25, gt=0)
     """First delay before retrying a `connect` endpoint or re-opening a client session."""
     reconnect_max_s: float = Field(default=1.0, gt=0)
+    delivery_wait_s: float = Field(default=5.0, ge=0, le=600)
+    """At the end of a source or a stop, with alerts not yet delivered (no link since they were
+    raised): how long to wait for a link before they are counted lost (docs/zenoh.md)."""
 
     @model_validator(mode="before")
     @classmethod

@@ -102,14 +102,15 @@ def check_model(config: Config) -> list[Check]:
 
 
 def landmarker_problem(model_path: Any) -> str | None:
-    """None when MediaPipe's FaceLandmarker loads the model (VIDEO mode, as the service does)."""
+    """None when the face landmarker loads the model (VIDEO mode and the default engine, as the
+    service starts)."""
     from roadgaze.config import LandmarksConfig
     from roadgaze.errors import RoadgazeError
 
     try:
-        from roadgaze.landmarks import MediaPipeLandmarker
+        from roadgaze.landmarks import Landmarker
 
-        MediaPipeLandmarker(LandmarksConfig(), model_path, video=True).close()
+        Landmarker(LandmarksConfig(), model_path, video=True).close()
     except (RoadgazeError, ImportError, OSError) as exc:
         return str(exc)
     return None

@@ -21,6 +21,7 @@ from roadgaze.config import Config, LandmarksConfig
 from roadgaze.errors import SourceError
 from roadgaze.evaluation.eyes import EyeEstimate, still_eyes
 from roadgaze.monitor.zones import ZoneMap
+from roadgaze.outputs.records import rounded
 from roadgaze.pose.estimator import PoseEstimator
 from roadgaze.pose.geometry import PAPER_CONSTANTS, YAW_MODELS, FaceModelConstants
 from roadgaze.pose.pitch import midline_pitch_deg
@@ -73,23 +74,24 @@ class ImageEstimate:
         return self.yaw_deg_by_model.get("center_ce")
 
     def to_json_dict(self) -> dict[str, Any]:
-        """The fields `roadgaze estimate` prints (no landmarks)."""
+        """The fields `roadgaze estimate` prints (no landmarks), rounded as `replay` rounds them:
+        angles to 3 decimals, pixels to 2."""
         result: dict[str, Any] = {
             "file": self.file,
             "face": self.face,
             "n_faces": self.n_faces,
-            "yaw_deg": self.yaw_deg,
-            "models": {name: self.yaw_deg_by_model.get(name) for name in MODEL_NAMES},
-            "pitch_deg": self.pitch_deg,
-            "pitch_geometric_deg": self.pitch_geometric_deg,
+            "yaw_deg": rounded(self.yaw_deg, 3),
+            "models": {name: rounded(self.yaw_deg_by_model.get(name), 3) for name in MODEL_NAMES},
+            "pitch_deg": rounded(self.pitch_deg, 3),
+            "pitch_geometric_deg": rounded(self.pitch_geometric_deg, 3),
             "zone": self.zone,
-            "mediapipe_yaw_deg": self.mediapipe_yaw_deg,
-            "mediapipe_pitch_deg": self.mediapipe_pitch_deg,
-            "x_left": self.x_left_px,
-            "x_right": self.x_right_px,
-            "x_center": self.x_center_px,
-            "roll_deg": self.roll_deg,
-            "quality": self.quality,
+            "mediapipe_yaw_deg": rounded(self.mediapipe_yaw_deg, 3),
+            "mediapipe_pitch_deg": rounded(self.mediapipe_pitch_deg, 3),
+            "x_left": rounded(self.x_left_px, 2),
+            "x_right": rounded(self.x_right_px, 2),
+            "x_center": rounded(self.x_center_px, 2),
+            "roll_deg": rounded(self.roll_deg, 2),
+            "quality": rounded(self.quality, 3),
         }
         if self.error is not None:
             result["error"] = self.error
@@ -240,9 +242,9 @@ def _init_worker(
 ) -> None:
     from multiprocessing.util import Finalize
 
-    from roadgaze.landmarks.landmarker import MediaPipeLandmarker
+    from roadgaze.landmarks.landmarker import Landmarker
 
-    _worker["detector"] = MediaPipeLandmarker(landmarks_config, model_path, video=False)
+    _worker["detector"] = Landmarker(landmarks_config, model_path, video=False)
     _worker["constants"] = constants
     _worker["still"] = StillPose.from_config(config)
     # Runs when the worker leaves its loop, while MediaPipe's threads are still alive (an atexit
@@ -277,10 +279,10 @@ def estimate_images(
     bar = tqdm(total=len(jobs), desc=description, unit="img", disable=not progress, leave=False)
     try:
         if workers <= 1 or len(jobs) <= 1:
-            from roadgaze.landmarks.landmarker import MediaPipeLandmarker
+            from roadgaze.landmarks.landmarker import Landmarker
 
             still = StillPose.from_config(config)
-            with MediaPipeLandmarker(landmarks_config, model_path, video=False) as detector:
+            with Landmarker(landmarks_config, model_path, video=False) as detector:
                 for path, name in jobs:
                     yield estimate_image(detector, path, constants, name, still)
                     bar.update(1)

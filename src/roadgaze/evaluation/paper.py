@@ -52,7 +52,7 @@ def experiment_1(
         name: np.asarray(model(face.x_left, face.x_right, face.x_center, constants))
         for name, model in YAW_MODELS.items()
     }
-    return Experiment("Experiment 1 (forward model)", truth, estimates)
+    return Experiment("Table III, Experiment 1 (forward model)", truth, estimates)
 
 
 def draw_head_top_view(
@@ -122,7 +122,7 @@ def experiment_2(
         name: np.asarray(model(measured[:, 0], measured[:, 1], measured[:, 2], constants))
         for name, model in YAW_MODELS.items()
     }
-    return Experiment("Experiment 2 (drawn 640x480 top view)", truth, estimates)
+    return Experiment("Table IV, Experiment 2 (drawn 640x480 top view)", truth, estimates)
 
 
 def range_errors(

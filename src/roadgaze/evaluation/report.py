@@ -21,6 +21,11 @@ import numpy as np
 import numpy.typing as npt
 
 from roadgaze.evaluation.eyes import EyeEstimate, EyeReport, evaluate_eyes, format_eye_report
+from roadgaze.evaluation.full_range_cv import (
+    CrossValidation,
+    cross_validate_full_range,
+    format_cross_validation,
+)
 from roadgaze.evaluation.ground_truth import GroundTruth
 from roadgaze.evaluation.images import MODEL_NAMES, ImageEstimate
 from roadgaze.evaluation.pitch import PitchReport, evaluate_pitch, format_pitch_report
@@ -120,6 +125,9 @@ class EvaluationReport:
     refit: Mapping[str, Any] | None = None
     pitch: PitchReport | None = None
     eyes: EyeReport | None = None
+    cross_validation: CrossValidation | None = None
+    """The full-range blend with its constants re-fitted leaving each subject out (data sets
+    with a `subject` column)."""
 
     def to_json_dict(self) -> dict[str, Any]:
         return {
@@ -147,6 +155,9 @@ class EvaluationReport:
             "refit": self.refit,
             "pitch": None if self.pitch is None else self.pitch.to_json_dict(),
             "eyes": None if self.eyes is None else self.eyes.to_json_dict(),
+            "cross_validation": (
+                None if self.cross_validation is None else self.cross_validation.to_json_dict()
+            ),
         }
 
 
@@ -194,6 +205,7 @@ def evaluate(
         bins=tuple(bins),
         pitch=evaluate_pitch(truths, estimates),
         eyes=evaluate_eyes(truths, estimates),
+        cross_validation=cross_validate_full_range(truths, estimates, constants),
     )
 
 
@@ -226,18 +238,26 @@ def format_report(report: EvaluationReport) -> str:
                 f"{fmt(s.bias_deg):>6}"
             )
         lines.append("")
-    lines.append("MAE (deg) per 15 deg bin of true yaw (det% = face found):")
     bin_header = f"{'yaw':>5} {'n':>5} {'det%':>6} " + " ".join(
         f"{METHOD_LABELS[m][:11]:>11}" for m in METHODS
     )
-    lines.append(bin_header)
-    lines.append("-" * len(bin_header))
-    for b in report.bins:
-        first = b.stats[MODEL_NAMES[0]]
-        lines.append(
-            f"{b.center_deg:>5.0f} {first.n_images:>5} {fmt(100 * first.detection_rate, 1):>6} "
-            + " ".join(f"{fmt(b.stats[m].mae_deg):>11}" for m in METHODS)
-        )
+    for title, value in (
+        ("MAE (deg) per 15 deg bin of true yaw (det% = face found):", "mae_deg"),
+        ("bias (mean signed error, deg) per 15 deg bin of true yaw:", "bias_deg"),
+    ):
+        lines += [title, bin_header, "-" * len(bin_header)]
+        for b in report.bins:
+            first = b.stats[MODEL_NAMES[0]]
+            lines.append(
+                f"{b.center_deg:>5.0f} {first.n_images:>5} "
+                f"{fmt(100 * first.detection_rate, 1):>6} "
+                + " ".join(f"{fmt(getattr(b.stats[m], value)):>11}" for m in METHODS)
+            )
+        lines.append("")
+    lines.pop()
+    if report.cross_validation is not None:
+        lines.append("")
+        lines.append(format_cross_validation(report.cross_validation))
     if report.pitch is not None:
         lines.append("")
         lines.append(format_pitch_report(report.pitch))

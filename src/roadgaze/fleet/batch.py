@@ -20,7 +20,7 @@ from typing import Literal
 from roadgaze.config import Config
 from roadgaze.errors import ConfigError
 from roadgaze.fleet.drives import Drive
-from roadgaze.fleet.engines import Engine, LocalEngine, RayEngine
+from roadgaze.fleet.engines import RAY_TIMEOUT_S, Engine, LocalEngine, RayEngine
 from roadgaze.fleet.report import render_report
 from roadgaze.fleet.results import DriveResult
 from roadgaze.fleet.summary import BatchOutcome, summary_table
@@ -49,6 +49,8 @@ class BatchOptions:
     workers: int | None = None
     """Local: processes (default: one per core). Ray: drives in flight (default: cluster CPUs)."""
     ray_address: str | None = None
+    ray_timeout_s: float = RAY_TIMEOUT_S
+    """How long to wait for the Ray cluster at `ray_address` before failing."""
     content_hash: bool = False
     retries: int = 2
     progress: bool = True
@@ -58,22 +60,43 @@ class BatchOptions:
 
 @contextmanager
 def batch_lock(out_dir: Path) -> Iterator[None]:
-    """Hold the output folder for this batch; ConfigError when another batch holds it."""
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-        descriptor = os.open(out_dir / LOCK_NAME, os.O_RDWR | os.O_CREAT, 0o644)
-    except OSError as exc:
-        raise ConfigError(f"cannot write to output folder {out_dir}: {exc.strerror}") from None
-    try:
+    """Hold the output folder for this batch; ConfigError when another batch holds it.
+
+    The lock file is removed on the way out, while still held. A batch that opened the file
+    just before it went checks, once it holds its lock, that the path still names the file it
+    locked, and takes a fresh one otherwise, so two batches never both hold the folder.
+    """
+    path = out_dir / LOCK_NAME
+    while True:
+        try:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            descriptor = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise ConfigError(f"cannot write to output folder {out_dir}: {exc.strerror}") from None
         try:
             fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
+            os.close(descriptor)
             raise ConfigError(
                 f"another roadgaze batch is writing to {out_dir}; wait for it or pick another --out"
             ) from None
+        if _same_file(descriptor, path):
+            break
+        os.close(descriptor)
+    try:
         yield
     finally:
+        path.unlink(missing_ok=True)
         os.close(descriptor)
+
+
+def _same_file(descriptor: int, path: Path) -> bool:
+    try:
+        named = path.stat()
+    except FileNotFoundError:
+        return False
+    held = os.fstat(descriptor)
+    return (held.st_dev, held.st_ino) == (named.st_dev, named.st_ino)
 
 
 def pinned_model(config: Config) -> Config:
@@ -88,7 +111,11 @@ def pinned_model(config: Config) -> Config:
 def make_engine(options: BatchOptions) -> Engine:
     if options.engine == "ray":
         return RayEngine(
-            options.out_dir / LOG_NAME, options.ray_address, options.workers, options.retries
+            options.out_dir / LOG_NAME,
+            options.ray_address,
+            options.workers,
+            options.retries,
+            options.ray_timeout_s,
         )
     return LocalEngine(options.out_dir / LOG_NAME, options.workers, options.retries)
 
@@ -160,7 +187,7 @@ def run_batch(drives: Sequence[Drive], config: Config, options: BatchOptions) ->
             run_start = time.perf_counter()
             progress = BatchProgress(len(to_run), options.progress)
             try:
-                with signal_handlers(stop):
+                with signal_handlers(stop, log_name="roadgaze.batch", hard_exit=False):
                     for result in engine.run(to_run, stop):
                         results[result.drive_id] = result
                         progress.update(result)
@@ -176,6 +203,8 @@ def run_batch(drives: Sequence[Drive], config: Config, options: BatchOptions) ->
             wall_s=wall_s,
             startup_s=startup_s,
             interrupted=stop.is_set(),
+            worker_deaths=getattr(engine, "worker_deaths", 0),
+            retries=getattr(engine, "retried", 0),
         )
         write_summary(out_dir, outcome)
     return outcome

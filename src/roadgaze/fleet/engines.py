@@ -27,14 +27,19 @@ from types import TracebackType
 from typing import Any, Protocol
 
 from roadgaze.errors import ConfigError, RoadgazeError
+from roadgaze.fleet.ray_connect import bounded_call, wait_for_ray_head
 from roadgaze.fleet.results import DriveResult
 from roadgaze.fleet.task import DriveTask, one_line, process_drive, use_stop_signal
 from roadgaze.pipeline import StopSignal
+
+log = logging.getLogger("roadgaze.batch")
 
 POLL_S = 0.2
 """How often the parent looks at `stop` while it waits for drives."""
 
 RAY_MISSING = "the ray engine needs Ray, which is not installed: pip install 'roadgaze[ray]'"
+RAY_TIMEOUT_S = 30.0
+"""How long `batch --engine ray` waits for a Ray cluster at an address (`--ray-timeout`)."""
 
 
 class Engine(Protocol):
@@ -109,6 +114,10 @@ class LocalEngine:
         self._context = multiprocessing.get_context("spawn")
         self._executor: ProcessPoolExecutor | None = None
         self._worker_stop: Any = None
+        self.worker_deaths = 0
+        """Worker processes that died on a drive (a crash in native code, the OOM killer)."""
+        self.retried = 0
+        """Drives started again after their worker died."""
 
     def __enter__(self) -> LocalEngine:
         self._worker_stop = self._context.Event()
@@ -163,6 +172,22 @@ class LocalEngine:
                 process.terminate()
         executor.shutdown(wait=not terminate, cancel_futures=True)
 
+    def _worker_died(self, drive_id: str, tries: int, retry: bool) -> None:
+        """Log a worker's death on stderr and in the batch log, and count it."""
+        self.worker_deaths += 1
+        self.retried += int(retry)
+        then = "trying it again" if retry else "giving up on it (--retries)"
+        message = (
+            f"batch: a worker process died while running drive {drive_id} (try {tries} of "
+            f"{self.retries + 1}; a crash in native code or out of memory): {then}"
+        )
+        log.warning(message)
+        try:
+            with self._log_path.open("a", encoding="utf-8") as batch_log:
+                batch_log.write(f"{time.strftime('%Y-%m-%d %H:%M:%S')} {message}\n")
+        except OSError as exc:
+            log.debug("batch log not written: %s", exc)
+
     def run(self, tasks: Iterable[DriveTask], stop: StopSignal) -> Iterator[DriveResult]:
         queue = deque(tasks)
         in_flight: dict[Future[DriveResult], DriveTask] = {}
@@ -188,12 +213,15 @@ class LocalEngine:
                     yield future.result()
                 except BrokenProcessPool:
                     broken = True
-                    tries[task.drive.drive_id] += 1
-                    if tries[task.drive.drive_id] > self.retries:
+                    drive_id = task.drive.drive_id
+                    tries[drive_id] += 1
+                    retry = tries[drive_id] <= self.retries
+                    self._worker_died(drive_id, tries[drive_id], retry)
+                    if not retry:
                         yield DriveResult.of(
                             task.drive,
                             "failed",
-                            error=f"the worker process died {tries[task.drive.drive_id]} times "
+                            error=f"the worker process died {tries[drive_id]} times "
                             "on this drive (a crash in native code or out of memory)",
                         )
                     else:
@@ -246,8 +274,10 @@ class RayEngine:
         address: str | None = None,
         workers: int | None = None,
         retries: int = 2,
+        timeout_s: float = RAY_TIMEOUT_S,
     ) -> None:
         self.address = address
+        self.timeout_s = timeout_s
         self._log_path = log_path
         self.workers = workers or 0
         self.retries = retries
@@ -261,11 +291,19 @@ class RayEngine:
             options: dict[str, Any] = {"log_to_driver": False, "logging_level": logging.ERROR}
             if self.address is None and not os.environ.get("RAY_ADDRESS"):
                 options["include_dashboard"] = False
+            where = self.address or os.environ.get("RAY_ADDRESS") or "a local instance"
+            deadline = time.monotonic() + self.timeout_s
+            if where != "a local instance":
+                wait_for_ray_head(where, deadline, self.timeout_s)
             try:
                 with stderr_to(self._log_path):
-                    ray.init(address=self.address, **options)
+                    bounded_call(lambda: ray.init(address=self.address, **options), deadline)
+            except TimeoutError:
+                raise ConfigError(
+                    f"no Ray cluster answered at {where} within {self.timeout_s:g} s "
+                    f"(--ray-timeout); see {self._log_path}"
+                ) from None
             except (ConnectionError, ValueError, RuntimeError) as exc:
-                where = self.address or os.environ.get("RAY_ADDRESS") or "a local instance"
                 raise ConfigError(
                     f"cannot start or reach Ray at {where}: {one_line(exc)}"
                 ) from None

@@ -2,7 +2,10 @@
 
 Fleet totals first, then the drives that failed and why, the table per driver, three plots and
 the table per drive (worst first: most alerts per hour). Every value read from the input (ids,
-paths, error messages) is escaped.
+paths, error messages) is escaped. The page fits a 1280 px wide window: the tables leave out the
+alert kinds no drive of the batch raised (said under the table), column heads wrap, and a table
+still wider than the page scrolls inside its own box instead of being cut off; plot legends sit
+beside the plot, never over a bar.
 """
 
 from __future__ import annotations
@@ -22,10 +25,12 @@ MAX_DRIVE_ROWS = 2000
 """Per-drive rows shown in the report (every drive is in summary.parquet)."""
 
 _STYLE = """
-body{font:14px/1.4 system-ui,sans-serif;margin:2em auto;max-width:1200px;color:#222;padding:0 1em}
+body{font:14px/1.4 system-ui,sans-serif;margin:2em auto;max-width:1240px;color:#222;padding:0 1em}
 h1{font-size:1.6em}h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #ccc}
-table{border-collapse:collapse;font-size:13px}td,th{padding:3px 8px;border-bottom:1px solid #eee}
-th{text-align:left;background:#f4f4f4;position:sticky;top:0}td.n{text-align:right;white-space:nowrap}
+.wide{overflow-x:auto;max-width:100%}
+table{border-collapse:collapse;font-size:13px}td,th{padding:3px 6px;border-bottom:1px solid #eee}
+th{text-align:left;background:#f4f4f4;position:sticky;top:0;vertical-align:bottom;
+white-space:normal;min-width:3.5em}td.n{text-align:right;white-space:nowrap}
 .cards{display:flex;flex-wrap:wrap;gap:12px}.card{border:1px solid #ddd;border-radius:6px;
 padding:8px 14px;min-width:130px}.card b{display:block;font-size:1.5em}.bad{color:#b00}
 td:first-child{white-space:nowrap}img{max-width:100%;margin:8px 0}.note{color:#666}
@@ -63,7 +68,8 @@ def _table(header: Sequence[str], rows: Sequence[Sequence[str]], numeric_from: i
         + "</tr>"
         for row in rows
     )
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    table = f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    return f'<div class="wide">{table}</div>'
 
 
 def _png(draw: Callable[[Any], None], size: tuple[float, float] = (7.0, 3.2)) -> str:
@@ -85,22 +91,24 @@ def _png(draw: Callable[[Any], None], size: tuple[float, float] = (7.0, 3.2)) ->
     return f'<img alt="plot" src="data:image/png;base64,{data}">'
 
 
+def alerts_by_driver(axes: Any, shown: Sequence[GroupStats]) -> None:
+    """Stacked bars of each driver's alerts per hour by kind; the legend beside the bars."""
+    left = [0.0] * len(shown)
+    for kind in ALERT_KINDS:
+        values = [d.alerts_per_h[kind] or 0.0 for d in shown]
+        axes.barh([d.name for d in shown], values, left=left, label=_kind_title(kind))
+        left = [a + b for a, b in zip(left, values, strict=True)]
+    axes.invert_yaxis()
+    axes.set_xlabel("alerts per hour of video")
+    axes.set_title("Alerts per hour by driver")
+    axes.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+
+
 def _plots(ok: Sequence[DriveResult], drivers: Sequence[GroupStats]) -> str:
     if not ok:
         return '<p class="note">No drive finished, so nothing to plot.</p>'
     shown = sorted(drivers, key=lambda d: -sum(v or 0.0 for v in d.alerts_per_h.values()))[:30]
     shown = [d for d in shown if d.drives_ok]
-
-    def alerts_by_driver(axes: Any) -> None:
-        left = [0.0] * len(shown)
-        for kind in ALERT_KINDS:
-            values = [d.alerts_per_h[kind] or 0.0 for d in shown]
-            axes.barh([d.name for d in shown], values, left=left, label=_kind_title(kind))
-            left = [a + b for a, b in zip(left, values, strict=True)]
-        axes.invert_yaxis()
-        axes.set_xlabel("alerts per hour of video")
-        axes.set_title("Alerts per hour by driver")
-        axes.legend(fontsize=8)
 
     def off_road(axes: Any) -> None:
         ratios = [100.0 * r.off_road_ratio for r in ok if r.off_road_ratio is not None]
@@ -121,7 +129,8 @@ def _plots(ok: Sequence[DriveResult], drivers: Sequence[GroupStats]) -> str:
         axes.set_title("Longest off-road episode per drive")
 
     height = max(2.5, 0.28 * len(shown) + 1.2)
-    return _png(alerts_by_driver, (7.0, height)) + _png(off_road) + _png(longest)
+    bars = _png(lambda axes: alerts_by_driver(axes, shown), (9.0, height))
+    return bars + _png(off_road) + _png(longest)
 
 
 def _totals(fleet: GroupStats, outcome: BatchOutcome) -> str:
@@ -170,7 +179,14 @@ def _failed(results: Sequence[DriveResult]) -> str:
     return _table(["drive", "status", "video", "why"], rows, numeric_from=99)
 
 
-def _drivers(drivers: Sequence[GroupStats]) -> str:
+def _kinds_note(kinds: Sequence[str]) -> str:
+    left_out = [_kind_title(k) for k in ALERT_KINDS if k not in kinds]
+    if not left_out:
+        return ""
+    return f'<p class="note">No drive raised {", ".join(left_out)}: those columns are left out.</p>'
+
+
+def _drivers(drivers: Sequence[GroupStats], kinds: Sequence[str]) -> str:
     header = [
         "driver",
         "drives",
@@ -178,7 +194,7 @@ def _drivers(drivers: Sequence[GroupStats]) -> str:
         "video",
         "face found",
         "off road",
-        *(f"{_kind_title(kind)} /h" for kind in ALERT_KINDS),
+        *(f"{_kind_title(kind)} /h" for kind in kinds),
         "longest off road (s)",
         "neutral yaw (deg)",
         "processing fps",
@@ -191,17 +207,17 @@ def _drivers(drivers: Sequence[GroupStats]) -> str:
             _hours(d.hours),
             _percent(d.face_found_rate),
             _percent(d.off_road_ratio),
-            *(_number(d.alerts_per_h[kind], 2) for kind in ALERT_KINDS),
+            *(_number(d.alerts_per_h[kind], 2) for kind in kinds),
             _number(d.longest_off_road_s),
             _number(d.neutral_yaw_deg),
             _number(d.processing_fps, 0),
         ]
         for d in drivers
     ]
-    return _table(header, rows)
+    return _table(header, rows) + _kinds_note(kinds)
 
 
-def _drives(ok: Sequence[DriveResult]) -> str:
+def _drives(ok: Sequence[DriveResult], kinds: Sequence[str]) -> str:
     def badness(result: DriveResult) -> tuple[float, float]:
         alerts = sum(n for _, n in result.alert_counts)
         return (-(per_hour(alerts, result.duration_s) or 0.0), -(result.off_road_ratio or 0.0))
@@ -215,7 +231,7 @@ def _drives(ok: Sequence[DriveResult]) -> str:
         "duration (s)",
         "face found",
         "off road",
-        *(f"{_kind_title(kind)} /h" for kind in ALERT_KINDS),
+        *(f"{_kind_title(kind)} /h" for kind in kinds),
         "longest off road (s)",
         "neutral yaw (deg)",
         "processing fps",
@@ -232,7 +248,7 @@ def _drives(ok: Sequence[DriveResult]) -> str:
                 _number(r.duration_s),
                 _percent(r.face_found_rate),
                 _percent(r.off_road_ratio),
-                *(_number(per_hour(counts.get(k, 0), r.duration_s), 1) for k in ALERT_KINDS),
+                *(_number(per_hour(counts.get(k, 0), r.duration_s), 1) for k in kinds),
                 _number(r.longest_off_road_s),
                 _number(r.neutral_yaw_deg),
                 _number(r.processing_fps, 0),
@@ -241,7 +257,7 @@ def _drives(ok: Sequence[DriveResult]) -> str:
     more = len(ordered) - MAX_DRIVE_ROWS
     note = f'<p class="note">{more:,} more drives in summary.parquet.</p>' if more > 0 else ""
     legend = '<p class="note">* kept from an earlier run. Worst first (alerts per hour).</p>'
-    return legend + _table(header, rows, numeric_from=4) + note
+    return legend + _table(header, rows, numeric_from=4) + _kinds_note(kinds) + note
 
 
 def render_report(outcome: BatchOutcome, title: str = "roadgaze fleet report") -> str:
@@ -250,6 +266,7 @@ def render_report(outcome: BatchOutcome, title: str = "roadgaze fleet report") -
     ok = [r for r in results if r.status == "ok"]
     fleet = group_stats("fleet", results)
     drivers = by_driver(results)
+    kinds = [kind for kind in ALERT_KINDS if fleet.alerts[kind]]
     made = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     return (
         f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{escape(title)}'
@@ -259,7 +276,7 @@ def render_report(outcome: BatchOutcome, title: str = "roadgaze fleet report") -
         "summary.parquet; per frame: frames/; per alert: alerts/.</p>"
         f"<h2>Fleet</h2>{_totals(fleet, outcome)}"
         f"<h2>Drives that did not finish</h2>{_failed(results)}"
-        f"<h2>Drivers</h2>{_drivers(drivers)}"
+        f"<h2>Drivers</h2>{_drivers(drivers, kinds)}"
         f"<h2>Plots</h2>{_plots(ok, drivers)}"
-        f"<h2>Drives</h2>{_drives(ok)}</body></html>\n"
+        f"<h2>Drives</h2>{_drives(ok, kinds)}</body></html>\n"
     )

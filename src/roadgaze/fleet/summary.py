@@ -173,6 +173,10 @@ class BatchOutcome:
     startup_s: float
     """Starting the engine (Ray: connecting or starting a local instance)."""
     interrupted: bool = False
+    worker_deaths: int = 0
+    """Local engine: worker processes that died on a drive (each cost that drive one try)."""
+    retries: int = 0
+    """Local engine: drives started again after their worker died."""
 
     @property
     def processed(self) -> tuple[DriveResult, ...]:
@@ -217,4 +221,6 @@ class BatchOutcome:
             "drive_startup_median_s": startups[len(startups) // 2] if startups else None,
             "drive_startup_max_s": startups[-1] if startups else None,
             "video_s": round(sum(r.duration_s for r in self.processed), 3),
+            "worker_deaths": self.worker_deaths,
+            "retries": self.retries,
         }

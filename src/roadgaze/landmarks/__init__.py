@@ -1,4 +1,4 @@
-"""Landmarks: MediaPipe FaceLandmarker, the model file, face and eye features with roll removed."""
+"""Landmarks: the face landmarker and its engines, the model file, face and eye features."""
 
 from roadgaze.landmarks.candidates import CANDIDATE_CHOICES
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored, unmirror
@@ -29,7 +29,7 @@ from roadgaze.landmarks.features import (
     remove_roll,
     roll_from_eyes_deg,
 )
-from roadgaze.landmarks.landmarker import MediaPipeLandmarker, to_rgb
+from roadgaze.landmarks.landmarker import Landmarker, MediaPipeLandmarker, to_rgb
 
 __all__ = [
     "CANDIDATE_CHOICES",
@@ -47,6 +47,7 @@ __all__ = [
     "RIGHT_EYE_OUTER",
     "EyeIndices",
     "LandmarkChoice",
+    "Landmarker",
     "MediaPipeLandmarker",
     "angles_from_matrix_deg",
     "boundaries_and_center",

@@ -103,6 +103,7 @@ def unmirror(face: FaceFeatures, image_width_px: int) -> FaceFeatures:
         y_center_px=face.y_center_px,
         blendshapes=None if face.blendshapes is None else swap_sides(face.blendshapes),
         eye_contrast=None if face.eye_contrast is None else face.eye_contrast[::-1],
+        eye_sharpness=None if face.eye_sharpness is None else face.eye_sharpness[::-1],
     )
 
 
@@ -152,6 +153,7 @@ def merge_mirrored(
                 y_center_px=_mean(face.y_center_px, other.y_center_px),
                 blendshapes=_mean_scores(face.blendshapes, other.blendshapes),
                 eye_contrast=face.eye_contrast,
+                eye_sharpness=face.eye_sharpness,
             )
         )
     return merged + candidates

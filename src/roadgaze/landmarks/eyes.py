@@ -206,6 +206,7 @@ def eye_features(
     quality: float = 1.0,
     contrast: tuple[float, float] | None = None,
     config: EyesConfig | None = None,
+    sharpness: tuple[float, float] | None = None,
 ) -> EyesFeatures:
     """Openness, direction and usability of both eyes of one face.
 
@@ -213,7 +214,8 @@ def eye_features(
     yaw (None when unknown: no eye gives a direction). `head_pitch_deg`: MediaPipe's matrix pitch
     (0 when None), used by the iris model only. `blendshapes`: the 52 scores by name (None: the
     direction falls back to the iris model, and there is no blink score). `contrast`: (right,
-    left) from `eye_contrast`. Raises ValueError for a wrong shape or non-finite landmarks.
+    left) from `eye_contrast`, `sharpness` likewise from `eye_sharpness`. Raises ValueError for
+    a wrong shape or non-finite landmarks.
     """
     config = config if config is not None else EyesConfig()
     points = np.asarray(landmarks_px, dtype=np.float64)
@@ -234,6 +236,7 @@ def eye_features(
         else dict(zip(("right", "left"), contrast, strict=True))
     )
     occluded = _occluded(openness, contrasts, config)
+    blurred = _blurred(sharpness, config)
     gaze_face = _face_reason(yaw, scale, quality, occluded, config.max_head_yaw_deg, config)
     closure_face = _face_reason(
         0.0 if yaw is None else yaw,
@@ -295,6 +298,7 @@ def eye_features(
         scale_px=scale,
         reason=reason,
         occluded=occluded,
+        blurred=blurred,
     )
 
 
@@ -314,6 +318,7 @@ def driver_eyes(
             face.quality,
             face.eye_contrast,
             config,
+            face.eye_sharpness,
         )
     except ValueError:
         return None
@@ -345,6 +350,14 @@ def _occluded(
         value < config.min_contrast and open_value >= config.occluded_min_openness
         for open_value, value in measured
     )
+
+
+def _blurred(sharpness: tuple[float, float] | None, config: EyesConfig) -> bool:
+    """Every measured eye's surroundings show weaker edges than `min_sharpness`."""
+    if sharpness is None or config.min_sharpness <= 0:
+        return False
+    measured = [value for value in sharpness if math.isfinite(value)]
+    return bool(measured) and all(value < config.min_sharpness for value in measured)
 
 
 def swap_sides(blendshapes: Mapping[str, float]) -> dict[str, float]:

@@ -1,9 +1,11 @@
-"""MediaPipe FaceLandmarker as a `LandmarkDetector`: IMAGE mode for stills, VIDEO mode for streams.
+"""The face landmarker as a `LandmarkDetector`: IMAGE mode for stills, VIDEO mode for streams.
 
-It measures every face with `features_from_landmarks` and chooses the driver among several faces
-by `LandmarksConfig.driver` (see `roadgaze.landmarks.driver`). The work of one frame comes in three
+Its models run on the engine `landmarks.engine` chooses (`roadgaze.landmarks.engines`: LiteRT, or
+MediaPipe's FaceLandmarker; `MediaPipeLandmarker` always runs MediaPipe's). It measures every face
+with `features_from_landmarks` and chooses the driver among several faces by
+`LandmarksConfig.driver` (see `roadgaze.landmarks.driver`). The work of one frame comes in three
 steps so that a stream can run them on three threads (`roadgaze.pipeline`): `prepare` (the image
-for MediaPipe; no state), `infer` (MediaPipe itself, the frames in order; in VIDEO mode also the
+for the engine; no state), `infer` (the engine itself, the frames in order; in VIDEO mode also the
 driver's choice, which the next frame's tracking needs) and `measure` (the features of each face;
 no state). `detect` is the three in a row.
 """
@@ -13,14 +15,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import numpy.typing as npt
 
 from roadgaze.config import Config, LandmarksConfig
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored
-from roadgaze.landmarks.eye_contrast import eye_contrast
+from roadgaze.landmarks.engines import FaceCounting, FaceRunner, open_engine
+from roadgaze.landmarks.eye_contrast import eye_contrast, eye_sharpness
 from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
 from roadgaze.landmarks.features import (
     DEFAULT_CHOICE,
@@ -28,15 +31,9 @@ from roadgaze.landmarks.features import (
     LandmarkChoice,
     features_from_landmarks,
 )
-from roadgaze.landmarks.multi_face import (
-    BackgroundCount,
-    FaceCounter,
-    FaceMode,
-    MultiFaceSwitch,
-    detector_model_bytes,
-)
+from roadgaze.landmarks.multi_face import BackgroundCount, FaceMode, MultiFaceSwitch
 from roadgaze.landmarks.native_log import filtered_native_stderr
-from roadgaze.landmarks.results import Blendshapes, run_landmarker
+from roadgaze.landmarks.results import Blendshapes
 from roadgaze.types import ClosesOnExit, Detection, FaceFeatures
 
 
@@ -71,11 +68,11 @@ def rgb_to_gray(rgb: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
 
 @dataclass(frozen=True, slots=True)
 class PreparedImage:
-    """An image converted for MediaPipe (`MediaPipeLandmarker.prepare`)."""
+    """An image converted for the engine (`Landmarker.prepare`)."""
 
     rgb: npt.NDArray[np.uint8]
-    mp_image: Any
-    """The `mediapipe.Image` (MediaPipe's own copy of `rgb`)."""
+    engine_image: Any
+    """What the engine reads: a `mediapipe.Image` (MediaPipe's own copy of `rgb`), or `rgb`."""
     gray: npt.NDArray[np.uint8]
     """The grey image the eye check measures."""
 
@@ -85,12 +82,12 @@ Box = tuple[float, float, float, float]
 
 @dataclass(frozen=True, slots=True)
 class FoundFace:
-    """One face as MediaPipe found it, before roadgaze measures it."""
+    """One face as the engine found it, before roadgaze measures it."""
 
     landmarks_px: npt.NDArray[np.float32]
     """(478, 3) landmarks: x, y in pixels, z in the scale of x; all finite."""
     matrix: npt.NDArray[np.float64] | None
-    """MediaPipe's 4x4 facial transformation matrix."""
+    """MediaPipe's 4x4 facial transformation matrix (the LiteRT engine computes the same)."""
     blendshapes: Blendshapes | None
     box_px: Box
     """(x_min, y_min, x_max, y_max) of the landmarks, pixels (what `FaceFeatures.box_px` holds)."""
@@ -98,7 +95,7 @@ class FoundFace:
 
 @dataclass(frozen=True, slots=True)
 class Inference:
-    """What MediaPipe found in one frame (`MediaPipeLandmarker.infer`), for `measure`."""
+    """What the engine found in one frame (`Landmarker.infer`), for `measure`."""
 
     gray: npt.NDArray[np.uint8]
     """The image the faces were found in, in grey (the eye check measures it)."""
@@ -109,8 +106,8 @@ class Inference:
     """`mirror_average`: the faces found in the horizontally flipped image."""
 
 
-class MediaPipeLandmarker(ClosesOnExit):
-    """MediaPipe FaceLandmarker as a `roadgaze.types.LandmarkDetector`; a context manager.
+class Landmarker(ClosesOnExit):
+    """The face landmarker as a `roadgaze.types.LandmarkDetector`; a context manager.
 
     `video=False`: IMAGE mode, each call independent (`t_s` must be None), up to
     `landmarks.max_faces` faces per image.
@@ -118,8 +115,12 @@ class MediaPipeLandmarker(ClosesOnExit):
     A stream runs a one-face landmarker and switches to the `max_faces` one only while a face
     count sees several faces (`roadgaze.landmarks.multi_face`); with
     `landmarks.multi_face_check_s = 0`, `max_faces = 1` or `mirror_average` every frame runs one
-    landmarker with `max_faces` faces.
+    landmarker with `max_faces` faces. `engine` overrides `landmarks.engine`. Raises ModelError
+    (one line) for a model that cannot be loaded.
     """
+
+    engine_override: ClassVar[str | None] = None
+    """An engine this class always runs, whatever `landmarks.engine` says."""
 
     def __init__(
         self,
@@ -127,68 +128,55 @@ class MediaPipeLandmarker(ClosesOnExit):
         model_path: Path,
         video: bool = False,
         choice: LandmarkChoice = DEFAULT_CHOICE,
+        engine: str | None = None,
     ) -> None:
-        import mediapipe as mp
-
         from roadgaze.errors import ModelError
 
-        self._mp = mp
         self._config = landmarks_config
         self._video = video
         self._choice = choice
         self._last_ms = -1
         self._last_t_s = -math.inf
         self._driver_box_px: Box | None = None
-        self._landmarker: Any = None
-        self._mirror_landmarker: Any = None
-        self._single_landmarker: Any = None
-        self._counter: FaceCounter | None = None
+        self._landmarker: FaceRunner | None = None
+        self._mirror_landmarker: FaceRunner | None = None
+        self._single_landmarker: FaceRunner | None = None
+        self._counter: FaceCounting | None = None
         self._background: BackgroundCount | None = None
         self._switch: MultiFaceSwitch | None = None
-        self._started: set[int] = set()
-        """Landmarkers (by id) that have run once."""
         switching = (
             video
             and landmarks_config.max_faces > 1
             and landmarks_config.multi_face_check_s > 0
             and not landmarks_config.mirror_average
         )
+        self._engine = open_engine(
+            landmarks_config, model_path, video, engine or self.engine_override
+        )
         try:
-            with filtered_native_stderr():
-                self._landmarker = self._create(model_path, landmarks_config.max_faces)
-                if landmarks_config.mirror_average:
-                    self._mirror_landmarker = self._create(model_path, landmarks_config.max_faces)
-                detector_model = detector_model_bytes(model_path) if switching else None
-                if detector_model is not None:
-                    self._single_landmarker = self._create(model_path, 1)
-                    self._counter = FaceCounter(
-                        detector_model, landmarks_config.min_detection_confidence
-                    )
-                    self._background = BackgroundCount(self._counter)
-                    self._switch = MultiFaceSwitch(landmarks_config.multi_face_check_s)
+            self._landmarker = self._engine.landmarker(landmarks_config.max_faces)
+            if landmarks_config.mirror_average:
+                self._mirror_landmarker = self._engine.landmarker(landmarks_config.max_faces)
+            counter = self._engine.counter() if switching else None
+            if counter is not None:
+                self._counter = counter
+                self._single_landmarker = self._engine.landmarker(1)
+                self._background = BackgroundCount(counter)
+                self._switch = MultiFaceSwitch(landmarks_config.multi_face_check_s)
         except (RuntimeError, ValueError, OSError) as exc:
             self.close()
             raise ModelError(f"cannot load face landmarker model {model_path}: {exc}") from None
+        except ModelError:
+            self.close()
+            raise
 
-    def _create(self, model_path: Path, num_faces: int) -> Any:
-        from mediapipe.tasks.python import vision
-        from mediapipe.tasks.python.core.base_options import BaseOptions
-
-        config = self._config
-        options = vision.FaceLandmarkerOptions(
-            base_options=BaseOptions(model_asset_path=str(model_path)),
-            running_mode=vision.RunningMode.VIDEO if self._video else vision.RunningMode.IMAGE,
-            num_faces=num_faces,
-            min_face_detection_confidence=config.min_detection_confidence,
-            min_face_presence_confidence=config.min_presence_confidence,
-            min_tracking_confidence=config.min_tracking_confidence,
-            output_facial_transformation_matrixes=True,
-            output_face_blendshapes=True,
-        )
-        return vision.FaceLandmarker.create_from_options(options)
+    @property
+    def engine(self) -> str:
+        """The engine that runs: `litert` or `mediapipe` (after any fallback)."""
+        return self._engine.name
 
     @classmethod
-    def from_config(cls, config: Config, video: bool = False) -> MediaPipeLandmarker:
+    def from_config(cls, config: Config, video: bool = False) -> Landmarker:
         """A landmarker with the model from `resolve_model` (fetched on first use if allowed)."""
         from roadgaze.landmarks.model_store import resolve_model
 
@@ -204,14 +192,13 @@ class MediaPipeLandmarker(ClosesOnExit):
         return FaceMode.MULTI if self._switch is None else self._switch.mode
 
     def prepare(self, image: npt.NDArray[np.uint8]) -> PreparedImage:
-        """The image as MediaPipe takes it (RGB, copied into a `mediapipe.Image`).
+        """The image as the engine takes it (RGB; for MediaPipe copied into a `mediapipe.Image`).
 
         Keeps no state, so another thread may prepare the next frame while this landmarker works
         (the loop's decode thread does). Raises ValueError for an image that is not uint8 2-D/3-D.
         """
         rgb = to_rgb(image)
-        mp_image = self._mp.Image(image_format=self._mp.ImageFormat.SRGB, data=rgb)
-        return PreparedImage(rgb, mp_image, rgb_to_gray(rgb))
+        return PreparedImage(rgb, self._engine.image(rgb), rgb_to_gray(rgb))
 
     def detect(self, image: npt.NDArray[np.uint8], t_s: float | None = None) -> Detection:
         """All faces in one BGR (or grayscale / BGRA) uint8 image and which one is the driver.
@@ -228,14 +215,15 @@ class MediaPipeLandmarker(ClosesOnExit):
         return self.measure(self.infer(prepared, t_s))
 
     def infer(self, prepared: PreparedImage, t_s: float | None = None) -> Inference:
-        """MediaPipe on an image `prepare` made: the faces in pixels and, in VIDEO mode, the driver.
+        """The engine on an image `prepare` made: the faces in pixels and, in VIDEO mode, the
+        driver.
 
         Calls must come in frame order (one thread at a time); the errors are `detect`'s but the
         image's.
         """
         if self._landmarker is None:
             raise ValueError("landmarker is closed")
-        rgb, mp_image = prepared.rgb, prepared.mp_image
+        rgb, mp_image = prepared.rgb, prepared.engine_image
         timestamp_ms: int | None = None
         if self._video:
             if t_s is None:
@@ -244,7 +232,7 @@ class MediaPipeLandmarker(ClosesOnExit):
                 raise ValueError(
                     f"timestamps must strictly increase: {t_s} s after {self._last_t_s} s"
                 )
-            # MediaPipe needs strictly increasing integer milliseconds.
+            # MediaPipe (and the LiteRT engine's smoothing) needs increasing integer milliseconds.
             timestamp_ms = max(round(t_s * 1000.0), self._last_ms + 1)
             self._last_t_s, self._last_ms = t_s, timestamp_ms
         elif t_s is not None:
@@ -256,9 +244,7 @@ class MediaPipeLandmarker(ClosesOnExit):
             faces = self._find(self._landmarker, mp_image, size, timestamp_ms)
         mirrored: list[FoundFace] = []
         if self._mirror_landmarker is not None:
-            flipped = self._mp.Image(
-                image_format=self._mp.ImageFormat.SRGB, data=np.ascontiguousarray(rgb[:, ::-1])
-            )
+            flipped = self._engine.image(np.ascontiguousarray(rgb[:, ::-1]))
             mirrored = self._find(self._mirror_landmarker, flipped, size, timestamp_ms)
         if not self._video:
             return Inference(prepared.gray, tuple(faces), None, tuple(mirrored))
@@ -320,18 +306,19 @@ class MediaPipeLandmarker(ClosesOnExit):
         return self._last_ms
 
     def _find(
-        self, landmarker: Any, mp_image: Any, size: tuple[int, int], timestamp_ms: int | None
+        self,
+        landmarker: FaceRunner | None,
+        mp_image: Any,
+        size: tuple[int, int],
+        timestamp_ms: int | None,
     ) -> list[FoundFace]:
-        """The faces of one run of `landmarker` on the `mediapipe.Image` `mp_image` of `size`
+        """The faces of one run of `landmarker` on the engine's image `mp_image` of `size`
         (width, height) pixels; a face with other than 478 landmarks or a non-finite one is
         dropped (`features_from_landmarks` could not measure it)."""
+        if landmarker is None:
+            raise ValueError("landmarker is closed")
         scale = np.array([size[0], size[1], size[0]], np.float32)
-        if id(landmarker) in self._started:
-            results = run_landmarker(landmarker, mp_image, timestamp_ms)
-        else:  # MediaPipe's first inference logs its set-up (tensor alignment) on fd 2
-            with filtered_native_stderr():
-                results = run_landmarker(landmarker, mp_image, timestamp_ms)
-            self._started.add(id(landmarker))
+        results = landmarker.run(mp_image, timestamp_ms)
         faces: list[FoundFace] = []
         for points, matrix, blendshapes in results:
             pixels = points * scale
@@ -345,15 +332,26 @@ class MediaPipeLandmarker(ClosesOnExit):
     def _features(
         self, found: tuple[FoundFace, ...], gray: npt.NDArray[np.uint8]
     ) -> list[FaceFeatures]:
-        """Each face measured, with its blendshapes and the contrast of its eye openings (on
-        `gray`, the image it was found in)."""
+        """Each face measured, with its blendshapes and the contrast and sharpness of its eyes
+        (on `gray`, the image it was found in)."""
         size = (gray.shape[1], gray.shape[0])
         faces: list[FaceFeatures] = []
         for face in found:
             pixels = face.landmarks_px
             features = features_from_landmarks(pixels, size, face.matrix, self._choice)
             contrast = (eye_contrast(gray, pixels, RIGHT_EYE), eye_contrast(gray, pixels, LEFT_EYE))
-            faces.append(replace(features, blendshapes=face.blendshapes, eye_contrast=contrast))
+            sharpness = (
+                eye_sharpness(gray, pixels, RIGHT_EYE),
+                eye_sharpness(gray, pixels, LEFT_EYE),
+            )
+            faces.append(
+                replace(
+                    features,
+                    blendshapes=face.blendshapes,
+                    eye_contrast=contrast,
+                    eye_sharpness=sharpness,
+                )
+            )
         return faces
 
     def close(self) -> None:
@@ -364,3 +362,10 @@ class MediaPipeLandmarker(ClosesOnExit):
                 if resource is not None:
                     resource.close()
                     setattr(self, name, None)
+
+
+class MediaPipeLandmarker(Landmarker):
+    """A `Landmarker` on MediaPipe's FaceLandmarker whatever `landmarks.engine` says: the
+    reference the LiteRT engine is held equal to."""
+
+    engine_override = "mediapipe"

@@ -23,7 +23,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from roadgaze.landmarks.driver import DRIVER_MATCH_IOU, box_iou
 from roadgaze.landmarks.native_log import filtered_native_stderr
@@ -147,11 +147,19 @@ class FaceCounter:
             self._detector = None
 
 
+class FaceCounting(Protocol):
+    """Counts faces in an engine's image (`FaceCounter`, or the LiteRT engine's detector)."""
+
+    def count(self, image: Any) -> int: ...
+
+    def close(self) -> None: ...
+
+
 class BackgroundCount:
     """One face count at a time on a thread of its own: `start` it on one frame, `take` it on
     the next."""
 
-    def __init__(self, counter: FaceCounter) -> None:
+    def __init__(self, counter: FaceCounting) -> None:
         self._counter = counter
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="roadgaze-facecount")
         self._pending: tuple[float, Future[int]] | None = None

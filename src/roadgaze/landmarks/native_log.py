@@ -1,12 +1,22 @@
-"""MediaPipe's own log lines on fd 2: start-up noise dropped, everything else passed on."""
+"""MediaPipe's own log lines on fd 2: start-up noise dropped, everything else passed on.
+
+A native line that is kept goes through roadgaze's log (logger `roadgaze.native`, its level from
+the glog letter: E0000 ... an error, W0000 ... a warning), so `--log-json` output stays one JSON
+object per line. Lines of roadgaze's own log and progress bars written meanwhile by other threads
+(they land on fd 2 too while it is captured) pass as they were.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
+import re
 import sys
 import tempfile
 from collections.abc import Iterator
+
+log = logging.getLogger("roadgaze.native")
 
 _NATIVE_NOISE = (
     "WARNING: Logging before InitGoogle()",
@@ -16,6 +26,26 @@ _NATIVE_NOISE = (
     "I0000 ",
 )
 """Start-up and shut-down lines of MediaPipe and LiteRT (its runtime) that say nothing to a user."""
+
+_OWN_LINE = re.compile(r"^(\{\"time\": |\d{4}-\d\d-\d\d \d\d:\d\d:\d\d,\d{3} [A-Z]+ )|\r")
+"""A line of roadgaze's log (JSON or text format) or of a progress bar (redrawn with \\r)."""
+
+_GLOG_LEVELS = {"F": logging.CRITICAL, "E": logging.ERROR, "W": logging.WARNING, "I": logging.INFO}
+
+
+def _pass_on(lines: list[str]) -> None:
+    """Roadgaze's own lines as they were; native ones as log records."""
+    for line in lines:
+        if _OWN_LINE.search(line):
+            sys.stderr.write(line)
+            sys.stderr.flush()
+        elif line.strip():
+            level = logging.WARNING
+            if re.match(r"^[FEWI]\d{4} ", line):
+                level = _GLOG_LEVELS[line[0]]
+            elif line.startswith(("ERROR:", "WARNING:", "INFO:")):
+                level = logging.getLevelName(line.split(":", 1)[0])
+            log.log(level, "%s", line.rstrip("\n"))
 
 
 @contextlib.contextmanager
@@ -40,6 +70,4 @@ def filtered_native_stderr() -> Iterator[None]:
                 for line in capture.read().decode("utf-8", "replace").splitlines(keepends=True)
                 if not line.startswith(_NATIVE_NOISE)
             ]
-            if kept:
-                sys.stderr.write("".join(kept))
-                sys.stderr.flush()
+            _pass_on(kept)

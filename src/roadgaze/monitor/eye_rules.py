@@ -78,6 +78,23 @@ def classify_eyes(
         return EyeStatus.OPEN, ""
     if head_below_road_deg is not None and head_below_road_deg > config.look_down_head_deg:
         return EyeStatus.OPEN, "looking down"
+    return _judgeable_closure(config, eyes, factor)
+
+
+def _judgeable_closure(
+    config: MonitorConfig, eyes: EyesFeatures, factor: float
+) -> tuple[EyeStatus, str]:
+    """Lids that read closed, unless the image cannot show them (fail-safe: unavailable, never
+    closed): no sharp edges around the eyes (motion blur, glare), or one judged eye while the
+    other, not judged (the far eye of a turned head), still reads open. A closure shuts both."""
+    if eyes.blurred:
+        return EyeStatus.UNAVAILABLE, "eyes blurred"
+    judged = [e for e in (eyes.right, eyes.left) if e.closure_usable]
+    others = [e for e in (eyes.right, eyes.left) if not e.closure_usable]
+    if len(judged) == 1 and any(
+        math.isfinite(e.openness) and e.openness >= config.eyes_close_below * factor for e in others
+    ):
+        return EyeStatus.UNAVAILABLE, "eyes disagree"
     return EyeStatus.CLOSED, "eyes closed"
 
 

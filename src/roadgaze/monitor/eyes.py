@@ -18,9 +18,11 @@ Definitions (thresholds in `MonitorConfig`; defaults and sources in docs/monitor
   kept for `perclos_window_s`.
 - **PERCLOS**: the closed share of the judged time in the last `perclos_window_s`, kept in 1 s
   bins (memory bounded whatever the frame rate), reported once `perclos_min_judged_s` is judged.
-- **Gaze** = head pose + the eye direction's deviation from the driver's resting eye direction
-  (learned on road), soft-thresholded by `gaze_deadband_deg`; the head pose alone when the eyes
-  give no direction or are closed.
+- **Gaze** = head pose + the eye direction's deviation from the driver's resting eye direction,
+  soft-thresholded per axis beyond the driver's measured noise (`roadgaze.monitor.eye_calibration`);
+  the head pose alone until the eyes are calibrated, or when they give no direction or are closed.
+  The calibration, the road pitch and the open-eye baseline learn from open-eyed samples on the
+  road with a steady head (|yaw rate| <= `neutral_max_rate_dps`).
 
 Events (raised only while moving): `microsleep` (warning) at a closure of `microsleep_s`,
 `sleep` (critical) at `sleep_s`, `unresponsive` (critical) at `unresponsive_closed_s`; `drowsy`
@@ -35,6 +37,7 @@ import math
 from dataclasses import dataclass, field, replace
 
 from roadgaze.config import MonitorConfig
+from roadgaze.monitor.eye_calibration import EyeCalibration, eye_shift_deg, learn_calibration
 from roadgaze.monitor.eye_rules import POPULATION_OPEN, classify_eyes, gaze_deg, soft_threshold
 from roadgaze.types import AlertKind, AlertLevel, EyeStatus, EyesVerdict, PoseSample
 
@@ -85,14 +88,19 @@ class EyeMonitorState:
     drowsy_armed: bool = True
     road_pitch_deg: float | None = None
     """The head's MediaPipe pitch looking at the road (learned)."""
-    eye_neutral_deg: tuple[float, float] = (0.0, 0.0)
-    """The driver's resting eye-in-head yaw and pitch (learned)."""
+    calibration: EyeCalibration = field(default_factory=EyeCalibration)
+    """The driver's resting eye-in-head direction and its noise (learned)."""
     learned_s: float = 0.0
-    """Road time the neutral values have learned from (a running mean until the time constant)."""
+    """Road time the road pitch has learned from (a running mean until the time constant)."""
     open_baseline: float | None = None
     unavailable_since_s: float | None = None
     degraded: bool = False
     verdict: EyesVerdict = field(default_factory=EyesVerdict)
+
+    @property
+    def eye_neutral_deg(self) -> tuple[float, float]:
+        """The driver's resting eye-in-head yaw and pitch (degrees; unclamped)."""
+        return self.calibration.yaw_deg, self.calibration.pitch_deg
 
     def closure_s(self) -> float:
         if self.closure_since_s is None or self.t_s is None:
@@ -200,15 +208,13 @@ def step_eyes(
         closure_since, raised = None, ()
     closure_s = 0.0 if closure_since is None else t - closure_since
 
-    # Neutral values, learned from open-eyed samples on the road.
-    road_pitch, eye_neutral, learned_s = (
-        state.road_pitch_deg,
-        state.eye_neutral_deg,
-        state.learned_s,
-    )
+    # Neutral values, learned from open-eyed samples on the road with a steady head.
+    road_pitch, calibration, learned_s = state.road_pitch_deg, state.calibration, state.learned_s
     baseline = state.open_baseline
+    rate, max_rate = sample.yaw_rate_dps, config.neutral_max_rate_dps
+    steady = rate is None or max_rate is None or not math.isfinite(rate) or abs(rate) <= max_rate
     open_on_road = status is EyeStatus.OPEN and not reason and on_road and eyes is not None
-    if open_on_road and dt > 0 and eyes is not None:
+    if open_on_road and steady and dt > 0 and eyes is not None:
         if mp_pitch is not None:
             road_pitch = (
                 mp_pitch
@@ -216,11 +222,7 @@ def step_eyes(
                 else _learn(road_pitch, mp_pitch, dt, learned_s, 90.0)
             )
         if eyes.yaw_deg is not None and eyes.pitch_deg is not None:
-            limit = config.eye_neutral_limit_deg
-            eye_neutral = (
-                _learn(eye_neutral[0], eyes.yaw_deg, dt, learned_s, limit),
-                _learn(eye_neutral[1], eyes.pitch_deg, dt, learned_s, limit),
-            )
+            calibration = learn_calibration(config, calibration, eyes.yaw_deg, eyes.pitch_deg, dt)
         if eyes.openness is not None:
             gain = 1.0 - math.exp(-min(dt, 1.0) / _BASELINE_TIME_CONSTANT_S)
             baseline = (
@@ -267,16 +269,19 @@ def step_eyes(
         events.append((AlertKind.DEGRADED, AlertLevel.WARNING, f"eyes unavailable: {reason}"))
         degraded = True
 
-    # Gaze: the eyes when open and giving a direction, else the head pose.
+    # Gaze: the calibrated eyes when open and giving a direction, else the head pose.
     gaze_yaw = gaze_pitch = None
     source = "none"
     if head_yaw_deg is not None:
-        pitch = head_pitch_deg if head_pitch_deg is not None else 0.0
-        use_eyes = eyes if status is EyeStatus.OPEN else None
-        gaze_yaw, gaze_pitch, used = gaze_deg(
-            head_yaw_deg, pitch, use_eyes, config.gaze_deadband_deg, eye_neutral
+        gaze_yaw, gaze_pitch = head_yaw_deg, head_pitch_deg if head_pitch_deg is not None else 0.0
+        source = "head"
+        shift = (
+            eye_shift_deg(config, calibration, eyes.yaw_deg, eyes.pitch_deg)
+            if status is EyeStatus.OPEN and eyes is not None
+            else None
         )
-        source = "eyes" if used else "head"
+        if shift is not None:
+            gaze_yaw, gaze_pitch, source = gaze_yaw + shift[0], gaze_pitch + shift[1], "eyes"
     judged = status is not EyeStatus.UNAVAILABLE
     verdict = EyesVerdict(
         status=status,
@@ -294,6 +299,7 @@ def step_eyes(
         last_blink_s=blinks[-1][1] if blinks else None,
         unavailable_s=unavailable_s,
         degraded=degraded,
+        calibration=calibration.status(),
     )
     new_state = replace(
         state,
@@ -307,7 +313,7 @@ def step_eyes(
         bins=bins,
         drowsy_armed=drowsy_armed,
         road_pitch_deg=road_pitch,
-        eye_neutral_deg=eye_neutral,
+        calibration=calibration,
         learned_s=learned_s,
         open_baseline=baseline,
         unavailable_since_s=unavailable_since,

@@ -281,7 +281,13 @@ def step(
             active.append(raised.kind)
 
     neutral_yaw, neutral_pitch, yaw_learned_s, pitch_learned_s = learn_neutral(
-        config, state, look.yaw_deg, look.pitch_deg, t_s, judged_on_road=look.zone == ROAD
+        config,
+        state,
+        look.yaw_deg,
+        look.pitch_deg,
+        t_s,
+        sample.yaw_rate_dps,
+        judged_on_road=look.zone == ROAD,
     )
     new_state = replace(
         state,

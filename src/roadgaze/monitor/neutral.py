@@ -25,6 +25,7 @@ def learn_neutral(
     yaw_deg: float | None,
     pitch_deg: float | None,
     t_s: float,
+    yaw_rate_dps: float | None = None,
     judged_on_road: bool = True,
 ) -> tuple[float, float, float, float]:
     """The neutral yaw and pitch after this sample and the time each has learned from.
@@ -36,14 +37,16 @@ def learn_neutral(
     road zone at first, is still learned. The yaw test is not: a sample in the hysteresis band
     may be a glance held just past the road's edge, and learning from it would walk the neutral
     after the glance until the glance reads as road (fail-safe: an alert is never learned
-    away). Once it has learned `SETTLE_S`, only a sample the monitor judged on the road
-    (`judged_on_road`) teaches: a held glance into the cluster or the lap, level enough to pass the
-    pitch test (a real 30 deg look down reads 10-15 deg), would otherwise walk the neutral pitch
-    after it until the glance reads as road (Pointing'04 subject 8: 4 deg in 2 s, alert lost;
-    scripts/held-out-check.py). The gain is the larger of
-    the first-order filter's (time constant `neutral_time_constant_s`) and a running mean's (dt
-    over the time learned so far): the neutral settles on the driver's road pose within seconds
-    of the start and then follows it slowly.
+    away). Nor does a head turning faster than `neutral_max_rate_dps` (`yaw_rate_dps`, None:
+    unknown) teach: it sweeps through the road on its way elsewhere (a single such sample would
+    otherwise set the neutral at the start of a drive). Once it has learned `SETTLE_S`, only a
+    sample the monitor judged on the road (`judged_on_road`) teaches: a held glance into the
+    cluster or the lap, level enough to pass the pitch test (a real 30 deg look down reads 10-15
+    deg), would otherwise walk the neutral pitch after it until the glance reads as road
+    (Pointing'04 subject 8: 4 deg in 2 s, alert lost; scripts/held-out-check.py). The gain is the
+    larger of the first-order filter's (time constant `neutral_time_constant_s`) and a running
+    mean's (dt over the time learned so far): the neutral settles on the driver's road pose within
+    seconds of the start and then follows it slowly.
     """
     yaw, pitch = state.neutral_yaw_deg, state.neutral_pitch_deg
     yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s
@@ -51,8 +54,15 @@ def learn_neutral(
         return yaw, pitch, yaw_s, pitch_s
     ahead = abs(yaw_deg - yaw) <= config.road_half_width_deg - config.hysteresis_deg
     level = pitch_deg is None or abs(pitch_deg) <= config.neutral_pitch_limit_deg
+    limit = config.neutral_max_rate_dps
+    steady = (
+        yaw_rate_dps is None
+        or limit is None
+        or not math.isfinite(yaw_rate_dps)
+        or abs(yaw_rate_dps) <= limit
+    )
     settled = max(yaw_s, pitch_s) >= SETTLE_S
-    if not (ahead and level) or (settled and not judged_on_road):
+    if not (ahead and level and steady) or (settled and not judged_on_road):
         return yaw, pitch, yaw_s, pitch_s
     dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
     slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)

@@ -329,8 +329,9 @@ def timers_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
     def of(value_s: float, limit_s: float | None) -> str:
         return f"{value_s:.1f} s" if limit_s is None else f"{value_s:.1f}/{limit_s:g} s"
 
-    limit_s = None if monitor is None else monitor.long_distraction_s
-    glance = of(verdict.distraction_s, verdict.distraction_warn_s or limit_s)  # the protocol's
+    # Against the protocol's warning time at this speed when the configuration is known.
+    limit_s = None if monitor is None else verdict.distraction_warn_s or monitor.long_distraction_s
+    glance = of(verdict.distraction_s, limit_s)
     window = of(verdict.window_off_road_s, None if monitor is None else monitor.vats_threshold_s)
     return f"off road {verdict.off_road_s:.1f} s  distraction {glance}  VATS window {window}"
 

@@ -10,7 +10,7 @@ import numpy.typing as npt
 
 from roadgaze.config import MonitorConfig
 from roadgaze.landmarks.eyes import EYES
-from roadgaze.types import EyeStatus, FrameRecord
+from roadgaze.types import EyeCalibrationStatus, EyeStatus, FrameRecord
 
 EYE_COLOURS_BGR = {
     EyeStatus.OPEN: (80, 220, 80),
@@ -61,8 +61,9 @@ def draw_eyes(canvas: npt.NDArray[np.uint8], record: FrameRecord, scale: float) 
 
 
 def eyes_line(record: FrameRecord, monitor: MonitorConfig | None = None) -> str:
-    """One line: eyes open/closed/unavailable, openness, gaze and its source, the closure (against
-    the microsleep threshold when the configuration is known), PERCLOS."""
+    """One line: eyes open/closed/unavailable, openness, gaze and its source, the eye calibration
+    while not calibrated ("eyes learning": the gaze is the head pose), the closure (against the
+    microsleep threshold when the configuration is known), PERCLOS."""
     eyes = record.verdict.eyes
     text = f"eyes {eyes.status.value.upper()}"
     if eyes.openness is not None:
@@ -73,6 +74,8 @@ def eyes_line(record: FrameRecord, monitor: MonitorConfig | None = None) -> str:
         text += (
             f"  gaze {eyes.gaze_yaw_deg:+.0f}/{eyes.gaze_pitch_deg:+.0f} deg ({eyes.gaze_source})"
         )
+    if eyes.calibration is not EyeCalibrationStatus.CALIBRATED:
+        text += f"  eyes {eyes.calibration.value}"
     if eyes.closure_s:
         limit = "" if monitor is None else f"/{monitor.microsleep_s:g}"
         text += f"  closed {eyes.closure_s:.1f}{limit} s"

@@ -1,11 +1,13 @@
 """The pose plot: what the monitor saw and decided, frame by frame, in one PNG.
 
-Panels, top to bottom: the alerts (labels laid out in rows so that none overlap); the yaw (raw,
-smoothed with its +-2 sigma band, the truth when known; the road zone around the monitor's
-learned neutral, with the narrower band the head must come back into (hysteresis); spans judged
-off road shaded); the pitch the same way, when the records have one; the off-road timers with
-their thresholds (the glance, the long-distraction timer, the time within the VATS window). Each
-plotted value is one `Series`: a new record field is one more entry in `SERIES`.
+Panels, top to bottom: the alerts (labels laid out in rows so that none overlap; no strip when
+there is no alert); the yaw (raw, smoothed with its +-2 sigma band, the truth when known, the
+gaze where the eyes give it; the road zone around the monitor's learned neutral, with the
+narrower band the head must come back into (hysteresis); spans judged off road shaded); the pitch
+the same way, with the gaze pitch (what puts a frame in `lap`), when the records have one; the
+off-road timers with their thresholds (one label per threshold value: equal thresholds share
+it); the eyes. Each plotted value is one `Series`: a new record field is one more entry in
+`SERIES`. A series without any value in the run says so in its legend entry.
 """
 
 from __future__ import annotations
@@ -14,12 +16,19 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 
 from roadgaze.config import MonitorConfig
 from roadgaze.errors import RoadgazeError
+from roadgaze.outputs.limits import (
+    TIMER_THRESHOLDS,
+    road_bands_deg,
+    road_pitch_bands_deg,
+    threshold_labels,
+    timer_thresholds,
+)
 from roadgaze.types import (
     Alert,
     AlertKind,
@@ -61,6 +70,8 @@ SERIES: tuple[Series, ...] = (
     Series("off road in the VATS window", lambda r: r.verdict.window_off_road_s, "timers",
            {"color": "tab:purple"}),
     Series("gaze (eyes)", lambda r: _eye_gaze_yaw_deg(r), "yaw", {"color": "tab:green", "lw": 1}),
+    Series("gaze pitch (eyes)", lambda r: _eye_gaze_pitch_deg(r), "pitch",
+           {"color": "tab:green", "lw": 1}),
     Series("eyes closed, this closure", lambda r: r.verdict.eyes.closure_s, "timers",
            {"color": "tab:brown", "lw": 0.8}),
     Series("openness", lambda r: r.verdict.eyes.openness, "eyes",
@@ -91,6 +102,12 @@ def _eye_gaze_yaw_deg(record: FrameRecord) -> float | None:
     return eyes.gaze_yaw_deg if eyes.gaze_source == "eyes" else None
 
 
+def _eye_gaze_pitch_deg(record: FrameRecord) -> float | None:
+    """The gaze pitch where the eyes gave it (None where it is the head's)."""
+    eyes = record.verdict.eyes
+    return eyes.gaze_pitch_deg if eyes.gaze_source == "eyes" else None
+
+
 def label_rows(spans: Sequence[tuple[float, float]], gap: float = 0.0) -> list[int]:
     """A row for each label so that labels in one row do not overlap.
 
@@ -109,52 +126,6 @@ def label_rows(spans: Sequence[tuple[float, float]], gap: float = 0.0) -> list[i
             ends[row] = end
         rows[index] = row
     return rows
-
-
-Degrees = TypeVar("Degrees", float, FloatArray)
-"""One frame's angle (a float) or every frame's (an array): the band functions take either."""
-
-
-def road_bands_deg(
-    neutral_deg: Degrees, monitor: MonitorConfig
-) -> tuple[tuple[Degrees, Degrees], tuple[Degrees, Degrees]]:
-    """The monitor's yaw limits per frame, degrees: the road-ahead band (neutral +-
-    `road_half_width_deg`, left on crossing it) and the narrower band a head off road must come
-    back into (neutral +- (`road_half_width_deg` - `hysteresis_deg`))."""
-    half = monitor.road_half_width_deg
-    back = max(0.0, half - monitor.hysteresis_deg)
-    return (neutral_deg - half, neutral_deg + half), (neutral_deg - back, neutral_deg + back)
-
-
-def road_pitch_bands_deg(
-    neutral_deg: Degrees, monitor: MonitorConfig
-) -> tuple[tuple[Degrees, Degrees], tuple[Degrees, Degrees]]:
-    """The road zone's pitch limits per frame, degrees: left beyond neutral + `road_pitch_deg`
-    grown by `hysteresis_deg`, entered again within neutral + `road_pitch_deg`."""
-    low, high = monitor.road_pitch_deg
-    grow = monitor.hysteresis_deg
-    return (neutral_deg + low - grow, neutral_deg + high + grow), (
-        neutral_deg + low,
-        neutral_deg + high,
-    )
-
-
-TIMER_THRESHOLDS: tuple[tuple[str, str, str], ...] = (
-    ("long_distraction_s", "long distraction", "tab:orange"),
-    ("critical_distraction_s", "critical", "tab:red"),
-    ("vats_threshold_s", "VATS", "tab:purple"),
-    ("microsleep_s", "microsleep", "tab:brown"),
-    ("sleep_s", "sleep", "tab:brown"),
-)
-"""The timers' thresholds drawn with them: the monitor setting, its label, its colour."""
-
-
-def timer_thresholds(monitor: MonitorConfig) -> list[tuple[str, float, str, str]]:
-    """(setting, seconds, label, colour) of each threshold in `TIMER_THRESHOLDS`."""
-    return [
-        (key, float(getattr(monitor, key)), label, colour)
-        for key, label, colour in TIMER_THRESHOLDS
-    ]
 
 
 def _runs(flags: Sequence[bool]) -> list[tuple[int, int]]:
@@ -208,6 +179,10 @@ class YawPlot(ClosesOnExit):
         self.alerts: list[Alert] = []
         self.label_boxes: list[tuple[float, float, float, float]] = []
         self.unlabelled_alerts = 0
+        self.legend_labels: dict[str, list[str]] = {}
+        """Per panel, its legend entries as saved (after `close`)."""
+        self.threshold_texts: list[str] = []
+        """The timer panel's threshold labels as saved (after `close`)."""
         self._closed = False
 
     @property
@@ -252,15 +227,19 @@ class YawPlot(ClosesOnExit):
             if name == "yaw"
             or any(np.isfinite(self.values[s.label]).any() for s in SERIES if s.panel == name)
         ]
+        strip = bool(self.alerts)  # no alert: no alert strip
+        heights = [0.9] * strip + [3.0 if p == "yaw" else 1.6 for p in panels]
         figure, axes_list = plt.subplots(
-            len(panels) + 1,
+            len(heights),
             1,
             sharex=True,
-            figsize=(12, 2.0 + 2.6 * len(panels)),
+            squeeze=False,
+            figsize=(12, 1.1 * strip + 0.9 + 2.6 * len(panels)),
             dpi=110,
-            gridspec_kw={"height_ratios": [0.9] + [3.0 if p == "yaw" else 1.6 for p in panels]},
+            gridspec_kw={"height_ratios": heights},
         )
-        events, *value_axes = axes_list
+        value_axes = list(axes_list[:, 0])
+        events = value_axes.pop(0) if strip else None
         axes = dict(zip(panels, value_axes, strict=True))
         t_s = np.asarray(self.t_s)
         self._draw_yaw(axes["yaw"], t_s)
@@ -276,19 +255,24 @@ class YawPlot(ClosesOnExit):
                                 lw=1.2, label="truth")  # fmt: skip
         for series in SERIES:
             if series.panel in axes:
-                axes[series.panel].plot(t_s, self.values[series.label], label=series.label,
-                                        **series.style)  # fmt: skip
+                values = self.values[series.label]
+                label = series.label
+                if not np.isfinite(values).any():
+                    label += " (no value in this run)"
+                axes[series.panel].plot(t_s, values, label=label, **series.style)
         for name, panel in axes.items():
             panel.set_ylabel(PANELS[name], fontsize=8)
             panel.grid(alpha=0.3)
-            panel.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7)
+            legend = panel.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7)
+            self.legend_labels[name] = [text.get_text() for text in legend.get_texts()]
             for alert in self.alerts:
                 colour = ALERT_COLOURS.get(alert.level.value, "tab:purple")
                 panel.axvline(alert.t_s, color=colour, linestyle="--", linewidth=0.9)
         value_axes[-1].set_xlabel("time (s)")
-        events.set_title(self.title or "head pose")
+        (events or value_axes[0]).set_title(self.title or "head pose")
         figure.tight_layout()
-        self._draw_alert_labels(figure, events)
+        if events is not None:
+            self._draw_alert_labels(figure, events)
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             figure.savefig(self.path)
@@ -332,11 +316,12 @@ class YawPlot(ClosesOnExit):
     def _draw_timers(self, axes: Any) -> None:
         if self.monitor is None:
             return
-        for _, seconds, name, colour in timer_thresholds(self.monitor):
+        for _, seconds, _, colour in timer_thresholds(self.monitor):
             axes.axhline(seconds, color=colour, lw=0.7, ls=":")
-            axes.annotate(f"{name} {seconds:g} s", (1.0, seconds),
-                          xycoords=("axes fraction", "data"), ha="right", va="bottom",
-                          fontsize=6, color=colour)  # fmt: skip
+        for seconds, text, colour in threshold_labels(self.monitor):
+            axes.annotate(text, (1.0, seconds), xycoords=("axes fraction", "data"), ha="right",
+                          va="bottom", fontsize=6, color=colour)  # fmt: skip
+            self.threshold_texts.append(text)
 
     def _draw_eyes(self, axes: Any, t_s: FloatArray) -> None:
         """Closed and unavailable stretches shaded; a synthetic clip's true openness."""
@@ -391,3 +376,16 @@ class YawPlot(ClosesOnExit):
 
 def _nan_for_none(value: float | None) -> float:
     return math.nan if value is None else value
+
+
+__all__ = [
+    "TIMER_THRESHOLDS",
+    "Series",
+    "YawPlot",
+    "alert_label",
+    "label_rows",
+    "road_bands_deg",
+    "road_pitch_bands_deg",
+    "threshold_labels",
+    "timer_thresholds",
+]

@@ -269,7 +269,8 @@ def _close_when_stopped(stop: StopSignal, source: FrameSource, done: threading.E
 
 
 def create_detector(config: Config) -> LandmarkDetector:
-    """The production detector: MediaPipe FaceLandmarker in VIDEO mode (model via model_store)."""
-    from roadgaze.landmarks import MediaPipeLandmarker
+    """The production detector: the face landmarker in VIDEO mode on `landmarks.engine` (model via
+    model_store)."""
+    from roadgaze.landmarks import Landmarker
 
-    return MediaPipeLandmarker.from_config(config, video=True)
+    return Landmarker.from_config(config, video=True)

@@ -57,7 +57,7 @@ class DetectorSteps:
     """A detector's landmark stage as the loop runs it: `prepare` (no state; the decode thread),
     `infer` (frames in order; the landmark thread) and `measure` (no state; the loop's thread).
 
-    `MediaPipeLandmarker` has the three; a detector with only `detect` (a test's fake) infers the
+    `Landmarker` has the three; a detector with only `detect` (a test's fake) infers the
     whole stage at once and `measure` passes its detection on.
     """
 

@@ -19,9 +19,9 @@ Without a matrix yaw it is Center-CE. The cue is never the label: it is measured
 
 Constants 20 / 90 deg: global over all Pointing'04 dev subjects, chosen with a margin so that the
 MAE within +-60 deg does not grow on either half of the subjects (docs/pose.md gives the per-bin
-table and the leave-half-of-the-subjects-out check). The ramp never reaches w = 1 on real faces
-(the largest matrix yaw seen is about 70 deg): beyond 60 deg the result is a cue-weighted
-compromise between the two models.
+table, the leave-one-subject-out check and the study of other range cues). The ramp never reaches
+w = 1 on real faces (the largest matrix yaw seen is about 70 deg): beyond 60 deg the result is a
+cue-weighted compromise between the two models.
 """
 
 from __future__ import annotations

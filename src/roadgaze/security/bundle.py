@@ -111,6 +111,40 @@ def _host_names(endpoint: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
     return tuple(sorted(dns)), tuple(sorted(ips))
 
 
+HOST_NAME = re.compile(
+    r"[A-Za-z0-9]([A-Za-z0-9-]{0,61}[A-Za-z0-9])?(\.[A-Za-z0-9]([A-Za-z0-9-]{0,61}[A-Za-z0-9])?)*"
+)
+
+
+def check_tls_endpoint(option: str, value: str) -> None:
+    """Raise ConfigError unless `value` is `tls/HOST:PORT` a router can listen on and clients
+    reach: HOST a host name, an IPv4 address or an IPv6 address in brackets, PORT 1-65535."""
+    usage = f"{option} must be tls/HOST:PORT (an IPv6 address in brackets: tls/[::1]:7447)"
+    protocol, _, host_port = value.partition("/")
+    host, _, port = host_port.rpartition(":")
+    if protocol != "tls" or not host or not port:
+        raise ConfigError(f"{usage}, found {value[:80]!r}")
+    if not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise ConfigError(f"{option}: port must be 1-65535, found {port[:20]!r} in {value[:80]!r}")
+    if host.startswith("[") or host.endswith("]") or ":" in host:
+        inner = host[1:-1] if host.startswith("[") and host.endswith("]") else None
+        try:
+            if inner is None or ipaddress.ip_address(inner).version != 6:
+                raise ValueError(host)
+        except ValueError:
+            raise ConfigError(
+                f"{usage}: {host[:60]!r} is not an IPv6 address in brackets"
+            ) from None
+        return
+    try:
+        ipaddress.ip_address(host)
+        return
+    except ValueError:
+        pass
+    if len(host) > 253 or not HOST_NAME.fullmatch(host):
+        raise ConfigError(f"{usage}: {host[:60]!r} is not a host name or an IP address")
+
+
 def _write(path: Path, data: bytes, private: bool = False) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.unlink(missing_ok=True)  # a new file gets the mode below
@@ -126,9 +160,7 @@ def _check(out_dir: Path, consumers: list[str], endpoint: str, listen: str, forc
     if len(set(consumers)) != len(consumers):
         raise ConfigError("consumer names must be distinct")
     for option, value in (("--endpoint", endpoint), ("--listen", listen)):
-        host_port = value.partition("/")[2]
-        if not value.startswith("tls/") or ":" not in host_port:
-            raise ConfigError(f"{option} must be tls/HOST:PORT, found {value!r}")
+        check_tls_endpoint(option, value)
     if out_dir.exists() and not out_dir.is_dir():
         raise ConfigError(f"{out_dir} exists and is not a folder")
     if out_dir.is_dir() and any(out_dir.iterdir()) and not force:

@@ -7,10 +7,12 @@ daemon without its final state.
 from __future__ import annotations
 
 import logging
+import os
 import signal
+import sys
 import threading
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from types import FrameType
 
 log = logging.getLogger("roadgaze.daemon")
@@ -37,17 +39,47 @@ class StopFlag:
         return self._event.wait(timeout_s)
 
 
+EXIT_SECOND_SIGNAL = 1
+"""Exit status after a second stop signal."""
+
+
+def exit_now(code: int) -> None:
+    """End the process at once with `code`, after flushing the log and the standard streams
+    (no finaliser runs: none can print "Exception ignored" or swallow the exit)."""
+    for handler in logging.getLogger().handlers:
+        handler.flush()
+    for stream in (sys.stdout, sys.stderr):
+        with suppress(OSError, ValueError):  # a closed pipe: nothing more to say
+            stream.flush()
+    os._exit(code)
+
+
 @contextmanager
-def signal_handlers(stop: StopFlag, doing: str = "finishing the current frame") -> Iterator[None]:
+def signal_handlers(
+    stop: StopFlag,
+    doing: str = "finishing the current frame",
+    log_name: str = "roadgaze.daemon",
+    hard_exit: bool = True,
+) -> Iterator[None]:
     """SIGINT/SIGTERM/SIGHUP set `stop` (the current frame is finished); a second one exits at
-    once (exit code 1). `doing` says in the log what happens next."""
+    once with status 1, at any spacing. `doing` says in the log what happens next, under the
+    logger `log_name`.
+
+    With `hard_exit` the second signal ends the process right there (`os._exit` after the log is
+    flushed): raising SystemExit from a signal handler can land inside a finaliser (MediaPipe's
+    `FaceLandmarker.__del__`), where Python prints "Exception ignored" and goes on. Without it
+    (the batch, which must stop its worker processes) it raises SystemExit(1).
+    """
+    logger = logging.getLogger(log_name)
 
     def on_signal(number: int, frame: FrameType | None) -> None:
         name = signal.Signals(number).name
         if stop.is_set():
-            log.warning("second %s: exiting without waiting", name)
-            raise SystemExit(1)
-        log.info("%s received: %s", name, doing)
+            logger.warning("second %s: exiting without waiting (exit status 1)", name)
+            if not hard_exit:
+                raise SystemExit(EXIT_SECOND_SIGNAL)
+            exit_now(EXIT_SECOND_SIGNAL)
+        logger.info("%s received: %s", name, doing)
         stop.set(name)
 
     previous = {number: signal.signal(number, on_signal) for number in STOP_SIGNALS}

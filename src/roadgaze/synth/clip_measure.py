@@ -140,13 +140,13 @@ def _mean_errors(items: list[ChannelErrors]) -> ChannelErrors:
 
 def _detect_clip(path: Path, config: Config) -> tuple[FloatArray, list[FaceFeatures | None]]:
     from roadgaze.capture import open_source
-    from roadgaze.landmarks import MediaPipeLandmarker
+    from roadgaze.landmarks import Landmarker
 
     times: list[float] = []
     faces: list[FaceFeatures | None] = []
     with (
         open_source(str(path), config) as source,
-        MediaPipeLandmarker.from_config(config, video=True) as detector,
+        Landmarker.from_config(config, video=True) as detector,
     ):
         for frame in source:
             faces.append(detector.detect(frame.image, frame.t_s).driver)

@@ -108,7 +108,7 @@ def measure_eye_recovery(
     renderer: EyeRenderer | None = None,
 ) -> EyeRecovery:
     """Render the three sets, run the landmark and eye stages on each still, keep every value."""
-    from roadgaze.landmarks import MediaPipeLandmarker, driver_eyes
+    from roadgaze.landmarks import Landmarker, driver_eyes
     from roadgaze.monitor.eye_rules import classify_eyes
     from roadgaze.pose import PoseEstimator
 
@@ -117,7 +117,7 @@ def measure_eye_recovery(
     pose = PoseEstimator.from_config(config)
     rows: list[list[float]] = []
     sets: list[str] = []
-    with MediaPipeLandmarker.from_config(config, video=False) as landmarker:
+    with Landmarker.from_config(config, video=False) as landmarker:
         rest = landmarker.detect(renderer.render_eyes(0.0, 0.0, EyeState())).driver
         road_pitch = None if rest is None else rest.mediapipe_pitch_deg
         for name, head_yaw, head_pitch, state in _frames():

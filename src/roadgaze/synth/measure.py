@@ -64,7 +64,7 @@ def measure_yaw_recovery(
     `video`: run the landmarker in VIDEO mode over the sweep as a 15 fps clip (as the service
     does); False: each still in IMAGE mode.
     """
-    from roadgaze.landmarks import MediaPipeLandmarker, features_from_landmarks
+    from roadgaze.landmarks import Landmarker, features_from_landmarks
     from roadgaze.landmarks.model_store import resolve_model
     from roadgaze.pose import PoseEstimator
 
@@ -77,7 +77,7 @@ def measure_yaw_recovery(
     estimate = np.full(count, np.nan)
     mesh_estimate = np.full(count, np.nan)
     model_path = resolve_model(config.model)
-    with MediaPipeLandmarker(config.landmarks, model_path, video=video) as detector:
+    with Landmarker(config.landmarks, model_path, video=video) as detector:
         pose = PoseEstimator.from_config(config)
         for index, yaw_deg in enumerate(truth):
             image = renderer.render(float(yaw_deg))
@@ -226,7 +226,7 @@ def measure_pitch_recovery(
     zone classifier run on each still exactly as the service computes them, relative to the
     frontal still. Raises ModelError when the landmarker model is unavailable.
     """
-    from roadgaze.landmarks import MediaPipeLandmarker
+    from roadgaze.landmarks import Landmarker
     from roadgaze.landmarks.model_store import resolve_model
     from roadgaze.pose import PoseEstimator, head_pitch_deg, midline_pitch_deg
 
@@ -241,7 +241,7 @@ def measure_pitch_recovery(
     geometric = np.full(count, np.nan)
     yaw = np.full(count, np.nan)
     pose = PoseEstimator.from_config(config)
-    with MediaPipeLandmarker(config.landmarks, resolve_model(config.model)) as detector:
+    with Landmarker(config.landmarks, resolve_model(config.model)) as detector:
         for index, (yaw_deg, pitch_deg) in enumerate(truth):
             face = detector.detect(renderer.render(float(yaw_deg), float(pitch_deg))).driver
             if face is None:

@@ -129,10 +129,10 @@ def photo_landmarks_px(photo_bgr: ImageBGR, config: Config | None = None) -> Flo
 
     Raises SourceError when the photo shows no face, ModelError when the model is unavailable.
     """
-    from roadgaze.landmarks.landmarker import MediaPipeLandmarker
+    from roadgaze.landmarks.landmarker import Landmarker
 
     config = config if config is not None else Config()
-    with MediaPipeLandmarker.from_config(config, video=False) as landmarker:
+    with Landmarker.from_config(config, video=False) as landmarker:
         face = landmarker.detect(photo_bgr).driver
     if face is None:
         raise SourceError("no face found in the photo; pass a photo with one clear frontal face")

@@ -31,6 +31,8 @@ class Checked:
     payload: dict[str, Any]
     missing_before: int = 0
     """Alerts only: how many sequence numbers of this publisher were skipped just before it."""
+    first: bool = False
+    """Alerts only: the first alert seen from this publisher (numbers before it were not seen)."""
 
 
 def vehicle_of(key: str, prefix_template: str) -> str:
@@ -75,10 +77,12 @@ class MessageChecker:
         vehicle_id = getattr(message, "vehicle_id", None)
         if vehicle != "?" and vehicle_id != vehicle:
             raise PayloadError(f"vehicle_id {str(vehicle_id)[:64]!r} on the key of {vehicle!r}")
-        missing = 0
+        missing, first_seen = 0, False
         if kind == "alert":
-            missing = self._continue(vehicle, source or PLAIN_PUBLISHER, int(payload["seq"]))
-        return Checked(kind, key, vehicle, payload, missing)
+            stream = (vehicle, source or PLAIN_PUBLISHER)
+            first_seen = stream not in self._next_seq
+            missing = self._continue(vehicle, stream[1], int(payload["seq"]))
+        return Checked(kind, key, vehicle, payload, missing, first_seen)
 
     def _continue(self, vehicle: str, source: str, seq: int) -> int:
         stream = (vehicle, source)

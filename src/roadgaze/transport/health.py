@@ -172,6 +172,7 @@ class Health:
                 speed_kmh=speed_kmh,
                 speed_source=speed_source,
                 alert_counts=dict(verdict.alert_counts),
+                eye_calibration=eyes.calibration,
                 protocol=monitor.protocol,
                 camera_mounting=monitor.mounting().name,
                 distraction_s=max(0.0, verdict.distraction_s),

@@ -26,18 +26,21 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections import deque
 from collections.abc import Callable
 from typing import Any
 
 from roadgaze.config import ZenohConfig
+from roadgaze.transport.declared import HEARTBEAT_S, Declared
 from roadgaze.transport.keys import Keys
+from roadgaze.transport.ledger import NAMED_LOST, AlertId
 from roadgaze.transport.link_state import LinkState
 from roadgaze.transport.messages import AlertMessage, TransportStatus, YawMessage
-from roadgaze.transport.responder import QUERY_RING, StateResponder
 from roadgaze.transport.session import (
     SessionPlan,
     build_zenoh_config,
+    check_daemon_file,
     insecure_endpoints,
     plan_session,
     zenoh_error_text,
@@ -47,92 +50,9 @@ from roadgaze.transport.vss import VSS_ATTACHMENT
 
 log = logging.getLogger(__name__)
 
-HEARTBEAT_S = 0.5
-"""How often the alert publisher announces its last sequence number (lost-alert detection)."""
-
-
-class _Declared:
-    """Everything declared on one open session; closed together."""
-
-    def __init__(self, session: Any, link: ZenohLink) -> None:
-        import zenoh
-        from zenoh.ext import CacheConfig, MissDetectionConfig, declare_advanced_publisher
-
-        self.session = session
-        self._entities: list[Any] = []
-        self.responder: StateResponder | None = None
-        keys = link.keys
-        try:
-            self._entities.append(
-                session.info.declare_transport_events_listener(
-                    link.link_state.on_event, history=True
-                )
-            )
-            self.alert = declare_advanced_publisher(
-                session,
-                keys.alert,
-                encoding=zenoh.Encoding.APPLICATION_JSON,
-                reliability=zenoh.Reliability.RELIABLE,
-                congestion_control=zenoh.CongestionControl.BLOCK,
-                priority=zenoh.Priority.REAL_TIME,
-                express=True,
-                cache=CacheConfig(max_samples=link.config.alert_cache_size),
-                # The stub lists both keywords as required; the runtime takes one (zenoh 1.10).
-                sample_miss_detection=MissDetectionConfig(heartbeat=HEARTBEAT_S),  # type: ignore[call-arg]
-                publisher_detection=True,
-            )
-            self._entities.append(self.alert)
-            self.vss: dict[str, Any] = {}
-            for key in link.vss_keys:
-                self.vss[key] = session.declare_publisher(
-                    key,
-                    encoding=zenoh.Encoding.TEXT_PLAIN,
-                    congestion_control=zenoh.CongestionControl.BLOCK,
-                    priority=zenoh.Priority.DATA,
-                )
-                self._entities.append(self.vss[key])
-            self.yaw = session.declare_publisher(
-                keys.yaw,
-                encoding=zenoh.Encoding.APPLICATION_JSON,
-                congestion_control=zenoh.CongestionControl.DROP,
-                priority=zenoh.Priority.DATA,
-            )
-            self._entities.append(self.yaw)
-            if link.speed is not None and keys.speed is not None:
-                speed_subscriber = session.declare_subscriber(
-                    keys.speed, zenoh.handlers.RingChannel(1)
-                )
-                self._entities.append(speed_subscriber)
-
-                def newest_payload() -> Any:
-                    sample = speed_subscriber.try_recv()
-                    return None if sample is None else sample.payload
-
-                link.speed.attach(newest_payload)
-            if link.state_reply is not None:
-                queryable = session.declare_queryable(
-                    keys.state, zenoh.handlers.RingChannel(QUERY_RING)
-                )
-                self._entities.append(queryable)
-                self.responder = StateResponder(queryable.handler, link.state_reply, link.reply)
-            self._entities.append(session.liveliness().declare_token(keys.alive))
-        except BaseException:
-            self.close()
-            raise
-
-    def close(self) -> None:
-        for entity in reversed(self._entities):
-            try:
-                entity.undeclare()
-            except Exception as exc:
-                log.debug("undeclare failed: %s", exc)
-        self._entities.clear()
-        if self.responder is not None:
-            self.responder.close()
-        try:
-            self.session.close()
-        except Exception as exc:
-            log.debug("session close failed: %s", exc)
+RECOVERY_GRACE_S = 4 * HEARTBEAT_S
+"""After a link came back at exit: time for subscribers with recovery to fetch the held alerts
+(a heartbeat, their query, the answer)."""
 
 
 class ZenohLink:
@@ -157,10 +77,11 @@ class ZenohLink:
         self.state_reply = state_reply
         self.speed = speed
         self._zconf, self.plan = build_zenoh_config(plan or plan_session(config, "daemon"))
+        check_daemon_file(self._zconf, self.plan, keys.vehicle_id)
         self.link_state = LinkState(config.alert_cache_size)
         self._lock = threading.Lock()
-        self._declared: _Declared | None = None
-        self._pending: deque[bytes] = deque(maxlen=config.alert_cache_size)
+        self._declared: Declared | None = None
+        self._pending: deque[tuple[bytes, AlertId]] = deque(maxlen=config.alert_cache_size)
         self._pending_dropped = 0
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -209,7 +130,7 @@ class ZenohLink:
             )
             return False
         try:
-            declared = _Declared(session, self)
+            declared = Declared(session, self)
         except Exception as exc:
             self.last_error = zenoh_error_text(exc)
             log.error("zenoh declarations failed: %s", self.last_error)
@@ -225,8 +146,8 @@ class ZenohLink:
                 if not pending:
                     self._declared = declared
                     return True
-            for payload in pending:
-                self._put(declared, payload)
+            for payload, alert in pending:
+                self._put(declared, payload, alert)
 
     def _reopen_loop(self) -> None:
         delay_s = self.config.reconnect_initial_s
@@ -272,27 +193,69 @@ class ZenohLink:
     def publish_alert(self, message: AlertMessage) -> None:
         """Publish (or, before a client session opens, hold) one alert; never raises."""
         payload = message.to_json_bytes()
+        alert = AlertId(message.seq, message.kind.value, message.level.value, message.t_s)
         with self._lock:
             declared = self._declared
             if declared is None:
                 if len(self._pending) == self._pending.maxlen:
                     self._pending_dropped += 1
-                    log.error("alert held before the session opened was dropped: queue full")
-                self._pending.append(payload)
+                    dropped = self._pending[0][1]
+                    self.link_state.gone(dropped, "dropped before the zenoh session opened")
+                    log.error(
+                        "alert %s dropped: held too long before the session opened",
+                        dropped.describe(),
+                    )
+                self._pending.append((payload, alert))
                 log.warning("alert %s held until the zenoh session opens", message.kind.value)
                 return
-        self._put(declared, payload)
+        self._put(declared, payload, alert)
 
-    def _put(self, declared: _Declared, payload: bytes) -> None:
+    def _put(self, declared: Declared, payload: bytes, alert: AlertId) -> None:
         # Never under self._lock: a BLOCK put may wait for a slow subscriber.
         try:
             declared.alert.put(payload)
         except Exception as exc:
-            self.link_state.count_alert(published=False)
+            self.link_state.count_alert(False, alert, f"its put failed: {zenoh_error_text(exc)}")
             self.last_error = f"alert put failed: {exc}"
             log.error("alert not published: %s", exc)
             return
-        self.link_state.count_alert(published=True)
+        self.link_state.count_alert(published=True, alert=alert)
+
+    def undelivered(self) -> tuple[int, int, list[str]]:
+        """(alerts waiting for a link: held in the cache or before the session; alerts gone;
+        the newest of both, named with their fate)."""
+        with self._lock:
+            pending = [alert for _, alert in self._pending]
+        held, gone, named = self.link_state.undelivered()
+        waiting = [f"{alert.describe()}: held, no zenoh session yet" for alert in pending]
+        return held + len(pending), gone, named + waiting[-NAMED_LOST:]
+
+    def settle(self, wait_s: float, stop: Callable[[], bool] = lambda: False) -> None:
+        """Before closing: with alerts still waiting for a link, wait up to `wait_s` for one
+        (then a moment, so subscribers with recovery fetch them from the cache)."""
+        waiting = self.undelivered()[0]
+        if not waiting or wait_s <= 0:
+            return
+        log.warning(
+            "%d alert%s not delivered yet: waiting up to %g s for a zenoh link "
+            "(zenoh.delivery_wait_s)",
+            waiting,
+            "" if waiting == 1 else "s",
+            wait_s,
+        )
+        deadline = time.monotonic() + wait_s
+        while self.undelivered()[0] and time.monotonic() < deadline and not stop():
+            time.sleep(0.05)
+        if not self.undelivered()[0]:
+            time.sleep(RECOVERY_GRACE_S)
+
+    def stop_ledger(self) -> None:
+        """At exit: alerts still waiting for a link (or a session) are gone."""
+        self.link_state.stopped()
+        with self._lock:
+            pending, self._pending = list(self._pending), deque(maxlen=self._pending.maxlen)
+        for _, alert in pending:
+            self.link_state.gone(alert, "never published: no zenoh session when the daemon stopped")
 
     def status(self) -> TransportStatus:
         with self._lock:
@@ -300,6 +263,7 @@ class ZenohLink:
             pending = len(self._pending)
         routers, peers, clients = self.link_state.remotes()
         counts = self.link_state.snapshot()
+        waiting, gone, named = self.undelivered()
         speed = self.speed
         return TransportStatus(
             mode="client"
@@ -335,6 +299,9 @@ class ZenohLink:
                 if declared is not None and declared.responder is not None
                 else 0
             ),
+            alerts_waiting=waiting,
+            alerts_lost=gone,
+            undelivered_alerts=named,
         )
 
     def publish_final_state(self) -> None:
@@ -363,5 +330,8 @@ class ZenohLink:
             declared, self._declared = self._declared, None
             if self._pending:
                 log.error("%d alerts never published: no zenoh session", len(self._pending))
+                pending, self._pending = list(self._pending), deque(maxlen=self._pending.maxlen)
+                for _, alert in pending:
+                    self.link_state.gone(alert, "never published: no zenoh session")
         if declared is not None:
             declared.close()

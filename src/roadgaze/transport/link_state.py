@@ -13,6 +13,8 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
+from roadgaze.transport.ledger import AlertId, AlertLedger
+
 log = logging.getLogger("roadgaze.daemon")
 
 
@@ -52,6 +54,8 @@ class LinkState:
         self.changed_at = time.monotonic()
         self._puts_while_down = 0
         self.counts = AlertCounts()
+        self.ledger = AlertLedger(cache_size)
+        """Which alerts are held for recovery or gone; read through `undelivered()`."""
 
     def on_event(self, event: Any) -> None:
         """Zenoh transport event callback: PUT = a transport opened, DELETE = it closed."""
@@ -71,6 +75,7 @@ class LinkState:
                 if up:
                     self.ups += 1
                     held, self._puts_while_down = self._puts_while_down, 0
+                    self.ledger.link_up()
                 else:
                     self.downs += 1
         if up and not was_up:
@@ -100,14 +105,18 @@ class LinkState:
             kinds = list(self._remote.values())
         return kinds.count("router"), kinds.count("peer"), kinds.count("client")
 
-    def count_alert(self, published: bool) -> None:
-        """Count one alert handed to the publisher (`published`) or whose put raised."""
+    def count_alert(
+        self, published: bool, alert: AlertId | None = None, why: str = "its put failed"
+    ) -> None:
+        """Count one alert handed to the publisher (`published`) or whose put raised (`why`)."""
         with self._lock:
             counts = self.counts
             if not published:
                 counts.failed += 1
+                self.ledger.gone(alert, why)
                 return
             counts.published += 1
+            self.ledger.published(alert, link_up=bool(self._remote))
             if self._remote:
                 counts.sent += 1
                 return
@@ -115,6 +124,22 @@ class LinkState:
             self._puts_while_down += 1
             if self._puts_while_down > self._cache_size:
                 counts.beyond_cache += 1
+
+    def gone(self, alert: AlertId | None, why: str) -> None:
+        """One alert that never reached the publisher (dropped before a session opened)."""
+        with self._lock:
+            self.ledger.gone(alert, why)
+
+    def stopped(self, why: str = "never delivered: no link when the daemon stopped") -> int:
+        """At exit: alerts still held (no link since they were published) are gone."""
+        with self._lock:
+            return self.ledger.stopped(why)
+
+    def undelivered(self) -> tuple[int, int, list[str]]:
+        """(held now, gone in all, the newest of both named with their fate)."""
+        with self._lock:
+            ledger = self.ledger
+            return len(ledger.held), ledger.lost_total, ledger.undelivered()
 
     def snapshot(self) -> AlertCounts:
         with self._lock:

@@ -16,6 +16,7 @@ from roadgaze.types import (
     Alert,
     AlertKind,
     AlertLevel,
+    EyeCalibrationStatus,
     EyeStatus,
     EyesVerdict,
     FrameRecord,
@@ -266,6 +267,23 @@ class TransportStatus(_Message):
     yaw_not_sent: int = 0
     speed_oversize: int = Field(default=0, description="Speed payloads dropped unread (size).")
     state_queries_answered: int = 0
+    alerts_waiting: int = Field(
+        default=0,
+        ge=0,
+        description="roadgaze.state/4: alerts published while no link was up (or held before "
+        "the session opened) and still waiting for one; gone if the daemon stops first.",
+    )
+    alerts_lost: int = Field(
+        default=0,
+        ge=0,
+        description="roadgaze.state/4: alerts that will never reach a subscriber: pushed out "
+        "of the cache, put failed, dropped before the session opened, or no link at exit.",
+    )
+    undelivered_alerts: list[str] = Field(
+        default_factory=list,
+        description="roadgaze.state/4: the newest waiting and lost alerts (at most 20 of "
+        "each), e.g. '#3 long_distraction critical t=5.00s: held, no link yet'.",
+    )
 
 
 class MonitorSnapshot(EyeFields):
@@ -297,6 +315,11 @@ class MonitorSnapshot(EyeFields):
     failure: str = Field(
         default="", description="The temporary failure in force ('' for none), with its reason."
     )
+    eye_calibration: EyeCalibrationStatus = Field(
+        default=EyeCalibrationStatus.NONE,
+        description="none, learning or calibrated: the eyes move the gaze only once the "
+        "driver's resting eye direction is learned (calibrated).",
+    )
 
 
 class StateMessage(_Message):
@@ -308,9 +331,11 @@ class StateMessage(_Message):
     the status `degraded` (with a problem saying why) while the eyes have been unavailable too
     long. `roadgaze.state/4` adds to `monitor` the protocol, the camera mounting, the
     distraction timer and the time and rule that warn at the current speed, and the temporary
-    failure in force; and `permanent_failure` (the camera gone past `permanent_failure_s`). The
-    monitor's angles are in the driver's frame (the camera mounting applied). Every earlier
-    field keeps its name and meaning.
+    failure in force, and the eye calibration (`eye_calibration`); `permanent_failure` (the
+    camera gone past `permanent_failure_s`); and `alerts_waiting`, `alerts_lost` and
+    `undelivered_alerts` to `transport` (the alert ledger). The monitor's angles are in the
+    driver's frame (the camera mounting applied). Every earlier field keeps its name and
+    meaning.
     """
 
     schema_id: Literal["roadgaze.state/4"] = Field(default="roadgaze.state/4", alias="schema")

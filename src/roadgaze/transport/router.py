@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, Self
 
 from roadgaze.errors import TransportError
-from roadgaze.transport.session import zenoh_error_text
+from roadgaze.transport.session import load_zenoh_file, zenoh_error_text
 from roadgaze.types import ClosesOnExit
 
 log = logging.getLogger("roadgaze.router")
@@ -67,10 +67,8 @@ def router_config(settings: RouterSettings) -> RouterConfig:
             default_listen = _endpoints(json.loads(zconf.get_json("listen/endpoints")))
         else:
             path = settings.config_file
-            if not path.is_file():
-                raise TransportError(f"zenoh config file {path} not found")
             default_listen = _endpoints(json.loads(zenoh.Config().get_json("listen/endpoints")))
-            zconf = zenoh.Config.from_file(str(path))
+            zconf = load_zenoh_file(path)
             mode = json.loads(zconf.get_json("mode"))
             if mode not in (None, "router"):
                 raise TransportError(
@@ -195,3 +193,19 @@ class Router(ClosesOnExit):
                 "zenoh router stopped (%d sessions served)",
                 self.sessions_opened,
             )
+
+
+ZENOH_LOG = "error,zenoh_link_tls=warn"
+"""Zenoh's own log in `roadgaze router`: errors, and the TLS link's warnings, which name each
+refused handshake (a plain TCP client, no or a foreign certificate). `RUST_LOG` replaces it."""
+
+
+def log_refused_handshakes() -> None:
+    """Turn on Zenoh's own log (stderr, Zenoh's format) for refused TLS handshakes: Zenoh opens
+    no transport for them, so the transport events never see them. Once per process."""
+    import zenoh
+
+    try:
+        zenoh.init_log_from_env_or(ZENOH_LOG)
+    except Exception as exc:  # already initialised in this process
+        log.debug("zenoh log not initialised: %s", exc)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import logging
+import re
 import socket
 import time
 from collections.abc import Callable
@@ -19,7 +20,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from roadgaze.config import ZenohConfig
-from roadgaze.errors import TransportError
+from roadgaze.errors import ConfigError, TransportError
 
 log = logging.getLogger(__name__)
 
@@ -141,8 +142,30 @@ def plan_session(
 
 
 def zenoh_error_text(exc: BaseException) -> str:
-    """Zenoh's error message without the Rust source location it appends."""
-    return str(exc).split(" at /")[0].rstrip(". ") or type(exc).__name__
+    """Zenoh's error message without the Rust source location it appends, on one line (a
+    JSON5 syntax error's "--> LINE:COLUMN" and "= expected ..." become "line L, column C:
+    expected ...")."""
+    text = str(exc).split(" at /")[0].rstrip(". ") or type(exc).__name__
+    where = re.search(r"-->\s*(\d+):(\d+)", text)
+    expected = re.search(r"=\s*(.+)$", text.strip())
+    if where and expected:
+        return f"line {where[1]}, column {where[2]}: {expected[1].strip()} (JSON5 syntax)"
+    return " ".join(text.split())
+
+
+def load_zenoh_file(path: Path) -> Any:
+    """`zenoh.Config.from_file(path)`; TransportError in one line naming the file when it is
+    missing, a folder, unreadable or not valid JSON5 / a valid Zenoh config."""
+    import zenoh
+
+    if path.is_dir():
+        raise TransportError(f"zenoh config file {path} is a folder; pass its zenoh.json5 file")
+    if not path.is_file():
+        raise TransportError(f"zenoh config file {path} not found")
+    try:
+        return zenoh.Config.from_file(str(path))
+    except Exception as exc:  # zenoh's ZError: syntax, unknown keys, bad values, permissions
+        raise TransportError(f"bad zenoh config file {path}: {zenoh_error_text(exc)}") from None
 
 
 def _endpoints_of(zconf: Any, path: str, mode: str) -> tuple[str, ...]:
@@ -162,10 +185,7 @@ def build_zenoh_config(plan: SessionPlan) -> tuple[Any, SessionPlan]:
 
     try:
         if plan.config_file is not None:
-            path = Path(plan.config_file)
-            if not path.is_file():
-                raise TransportError(f"zenoh config file {path} not found")
-            zconf = zenoh.Config.from_file(str(path))
+            zconf = load_zenoh_file(Path(plan.config_file))
         else:
             zconf = zenoh.Config()
         for key, value in plan.settings.items():
@@ -207,10 +227,85 @@ def open_session(
             reason = zenoh_error_text(exc)
         if stopped() or time.monotonic() + retry_s > deadline:
             raise TransportError(
-                f"cannot open a zenoh session ({plan.describe()}): {reason}; is `roadgaze run` "
-                "or a router up?"
+                f"cannot open a zenoh session ({plan.describe()}): {reason}; "
+                f"{unreachable_hint(plan)}"
             ) from None
         if not announced:
             log.info("waiting for a router or daemon (%s)", plan.describe())
+            hint = unreachable_hint(plan)
+            if hint.startswith("something listens"):  # it will not get better by waiting
+                log.warning("zenoh session refused (%s): %s", reason, hint)
             announced = True
         time.sleep(retry_s)
+
+
+def certificate_name(zconf: Any) -> str | None:
+    """The common name of the client certificate a Zenoh config presents (mutual TLS), or None
+    when it presents none or the file cannot be read (Zenoh itself reports that)."""
+    try:
+        path = json.loads(zconf.get_json("transport/link/tls/connect_certificate"))
+    except Exception:
+        return None
+    if not isinstance(path, str) or not path:
+        return None
+    try:
+        from cryptography import x509
+        from cryptography.x509.oid import NameOID
+
+        certificate = x509.load_pem_x509_certificate(Path(path).read_bytes())
+        names = certificate.subject.get_attributes_for_oid(NameOID.COMMON_NAME)
+    except (OSError, ValueError):
+        return None
+    return str(names[0].value) if names else None
+
+
+def check_daemon_file(zconf: Any, plan: SessionPlan, vehicle_id: str) -> None:
+    """Refuse a Zenoh file that is not this vehicle's daemon's: a router's, or one whose client
+    certificate names another role or vehicle (a router with access control silently drops every
+    put, token and queryable of such a daemon: no alert would reach anyone). Raises ConfigError
+    naming the file and the fix."""
+    if plan.config_file is None:
+        return
+    where = f"--zenoh-config {plan.config_file}"
+    if plan.mode == "router":
+        raise ConfigError(
+            f"{where} is a router's file (mode router): the daemon needs its own, e.g. "
+            "DIR/daemon/zenoh.json5 of `roadgaze security init`"
+        )
+    name = certificate_name(zconf)
+    expected = f"daemon.{vehicle_id}"
+    if name is None or name == expected:
+        return
+    role = name.split(".", 1)[0]
+    whose = {"consumer": "a consumer's", "speed": "the speed provider's", "router": "a router's"}
+    owner = whose.get(role, f"certificate {name!r}'s")
+    if role == "daemon":
+        owner = f"the daemon file of vehicle {name.split('.', 1)[1]!r}"
+    raise ConfigError(
+        f"{where} is {owner} (its certificate is {name}, this daemon publishes as vehicle "
+        f"{vehicle_id!r}): the router's access control would silently drop every alert, state "
+        f"and liveliness token. Use the daemon's file of the same bundle (DIR/daemon/zenoh.json5 "
+        f"of `roadgaze security init --vehicle-id {vehicle_id}`)"
+    )
+
+
+def unreachable_hint(plan: SessionPlan | None) -> str:
+    """Why a client session may not have opened: nothing listens, or something listens but
+    refused it (a TLS router reached over plain TCP, or a certificate it does not accept)."""
+    endpoints = [] if plan is None else list(plan.connect)
+    answering = [endpoint for endpoint in endpoints if endpoint_in_use(endpoint)]
+    if not answering:
+        return "is `roadgaze run` or a router up?"
+    plain = [endpoint for endpoint in answering if endpoint.startswith("tcp/")]
+    if plain:
+        return (
+            f"something listens at {', '.join(plain)} but refused the zenoh session: a router "
+            "with TLS only (roadgaze security init) takes tls/ endpoints and a consumer's file: "
+            "--zenoh-config DIR/consumer-NAME/zenoh.json5"
+        )
+    return (
+        f"something listens at {', '.join(answering)} but refused the TLS session: a "
+        "certificate from another CA, an expired one, or none (enable_mtls), or a router that "
+        "is not a zenoh one; check the consumer's files of the same `roadgaze security init` "
+        "bundle as the router's"
+    )

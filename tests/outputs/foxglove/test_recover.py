@@ -182,3 +182,24 @@ def test_the_mcap_source_reads_a_cut_file_up_to_its_last_chunk(
     for (t_s, image), (whole_t_s, whole_image) in zip(frames, all_frames, strict=False):
         assert t_s == whole_t_s and np.array_equal(image, whole_image)
     assert json.dumps(status.message).count("cut short") == 1
+
+
+def test_a_file_that_ends_after_a_whole_chunk_is_still_cut_short(
+    complete: Path, tmp_path: Path
+) -> None:
+    """`kill -9` just after a chunk was written leaves no half record, but no footer either:
+    the MCAP source reads every frame up to there and says the file is cut short."""
+    data = complete.read_bytes()
+    probe = tmp_path / "probe.mcap.part"
+    probe.write_bytes(data[: len(data) // 2])
+    boundary = recover_mcap(probe, tmp_path / "probe.mcap").bytes_read
+    cut = tmp_path / "boundary.mcap.part"
+    cut.write_bytes(data[:boundary])
+    recovery = recover_mcap(cut, tmp_path / "boundary.mcap")
+    assert recovery.bytes_lost == 0
+    with McapSource(cut) as source:
+        seen = [frame.index for frame in source]
+        assert source.status.truncated and "cut short" in (source.status.message or "")
+    assert len(seen) == read_mcap(recovery.path).counts["/camera/image"] > 0
+    with McapSource(complete) as source:
+        assert len(list(source)) > len(seen) and not source.status.truncated

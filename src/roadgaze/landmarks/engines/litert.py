@@ -1,0 +1,388 @@
+"""The face landmarker's three models on LiteRT, with MediaPipe's graph rebuilt around them.
+
+The models and the canonical face come from the same verified `face_landmarker.task` (a zip)
+MediaPipe reads. Per frame: the region of each face (from the previous frame's landmarks while
+one is tracked, else from the face detector), the region warped to the landmark model's input with
+OpenCV exactly as MediaPipe's `ImageToTensorCalculator` does on the CPU (a perspective warp of the
+region's corners, bilinear, borders replicated; the detector's input letterboxed with zeros), the
+landmark model, its face-presence score (kept above `min_presence_confidence`), in VIDEO mode
+with one face the one-euro smoothing, the blendshapes from their 146 landmarks and the
+transformation matrix from the canonical face (`roadgaze.landmarks.engines.geometry`). The rules
+are `roadgaze.landmarks.engines.graph`.
+
+`threads` sets LiteRT's thread count (1 by default: a worker per core scales, and a second thread
+was slower on a loaded 2-core machine). `delegate` is `xnnpack` (LiteRT's default CPU kernels),
+`none` (its reference-free builtin kernels without delegates) or the path of a delegate library
+(`load_delegate`): the way to a vehicle's NPU, e.g. the libraries of `ai-edge-litert-sdk-qualcomm`,
+`-mediatek`, `-intel` or `-google-tensor`.
+"""
+
+from __future__ import annotations
+
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from roadgaze.config import LandmarksConfig
+from roadgaze.errors import ModelError
+from roadgaze.landmarks.engines import graph
+from roadgaze.landmarks.engines.geometry import CanonicalFace, transformation_matrix
+from roadgaze.landmarks.native_log import filtered_native_stderr
+from roadgaze.landmarks.results import FaceArrays
+
+DETECTOR_MEMBER = "face_detector.tflite"
+LANDMARKS_MEMBER = "face_landmarks_detector.tflite"
+BLENDSHAPES_MEMBER = "face_blendshapes.tflite"
+GEOMETRY_MEMBER = "geometry_pipeline_metadata_landmarks.binarypb"
+LANDMARKS_SIZE = 256
+BLENDSHAPE_LANDMARKS = (
+    0, 1, 4, 5, 6, 7, 8, 10, 13, 14, 17, 21, 33, 37, 39, 40, 46, 52, 53, 54, 55, 58, 61, 63, 65,
+    66, 67, 70, 78, 80, 81, 82, 84, 87, 88, 91, 93, 95, 103, 105, 107, 109, 127, 132, 133, 136,
+    144, 145, 146, 148, 149, 150, 152, 153, 154, 155, 157, 158, 159, 160, 161, 162, 163, 168, 172,
+    173, 176, 178, 181, 185, 191, 195, 197, 234, 246, 249, 251, 263, 267, 269, 270, 276, 282, 283,
+    284, 285, 288, 291, 293, 295, 296, 297, 300, 308, 310, 311, 312, 314, 317, 318, 321, 323, 324,
+    332, 334, 336, 338, 356, 361, 362, 365, 373, 374, 375, 377, 378, 379, 380, 381, 382, 384, 385,
+    386, 387, 388, 389, 390, 397, 398, 400, 402, 405, 409, 415, 454, 466, 468, 469, 470, 471, 472,
+    473, 474, 475, 476, 477,
+)  # fmt: skip
+"""The landmarks the blendshape model reads, as x, y pixels (`face_blendshapes_graph.cc`)."""
+BLENDSHAPE_INDEX = np.array(BLENDSHAPE_LANDMARKS, np.intp)
+BLENDSHAPE_NAMES = (
+    "_neutral", "browDownLeft", "browDownRight", "browInnerUp", "browOuterUpLeft",
+    "browOuterUpRight", "cheekPuff", "cheekSquintLeft", "cheekSquintRight", "eyeBlinkLeft",
+    "eyeBlinkRight", "eyeLookDownLeft", "eyeLookDownRight", "eyeLookInLeft", "eyeLookInRight",
+    "eyeLookOutLeft", "eyeLookOutRight", "eyeLookUpLeft", "eyeLookUpRight", "eyeSquintLeft",
+    "eyeSquintRight", "eyeWideLeft", "eyeWideRight", "jawForward", "jawLeft", "jawOpen",
+    "jawRight", "mouthClose", "mouthDimpleLeft", "mouthDimpleRight", "mouthFrownLeft",
+    "mouthFrownRight", "mouthFunnel", "mouthLeft", "mouthLowerDownLeft", "mouthLowerDownRight",
+    "mouthPressLeft", "mouthPressRight", "mouthPucker", "mouthRight", "mouthRollLower",
+    "mouthRollUpper", "mouthShrugLower", "mouthShrugUpper", "mouthSmileLeft", "mouthSmileRight",
+    "mouthStretchLeft", "mouthStretchRight", "mouthUpperUpLeft", "mouthUpperUpRight",
+    "noseSneerLeft", "noseSneerRight",
+)  # fmt: skip
+DELEGATES = ("xnnpack", "none")
+"""Named delegates; anything else is the path of a delegate library."""
+
+
+@dataclass(frozen=True, slots=True)
+class Bundle:
+    """The bytes of the three models and the canonical face, read from a `.task` file."""
+
+    detector: bytes
+    landmarks: bytes
+    blendshapes: bytes
+    face: CanonicalFace
+
+    @classmethod
+    def read(cls, model_path: Path) -> Bundle:
+        """ModelError (one line naming the file) when it is not a face landmarker bundle."""
+        try:
+            with zipfile.ZipFile(model_path) as archive:
+                detector, landmarks = archive.read(DETECTOR_MEMBER), archive.read(LANDMARKS_MEMBER)
+                blendshapes = archive.read(BLENDSHAPES_MEMBER)
+                metadata = archive.read(GEOMETRY_MEMBER)
+        except (OSError, KeyError, zipfile.BadZipFile, EOFError) as exc:
+            raise ModelError(
+                f"{model_path} is not a readable face landmarker bundle ({exc}); "
+                "run `roadgaze model fetch --force`"
+            ) from None
+        return cls(detector, landmarks, blendshapes, CanonicalFace.from_metadata(metadata))
+
+
+def _load_delegate(path: str) -> Any:
+    """LiteRT's external delegate from the library at `path`. The library is opened first:
+    LiteRT's own loader leaves a half-made object behind on a bad path, whose clean-up prints a
+    traceback. OSError for a library that cannot be opened or is no delegate."""
+    import ctypes
+
+    from ai_edge_litert import interpreter as litert
+
+    library = ctypes.CDLL(path)
+    if not hasattr(library, "tflite_plugin_create_delegate"):
+        raise OSError(f"{path} is not a LiteRT delegate (no tflite_plugin_create_delegate)")
+    return litert.load_delegate(path)
+
+
+class _Model:
+    """One TFLite model on a LiteRT interpreter: write the input view, `invoke`, read outputs."""
+
+    def __init__(self, content: bytes, name: str, threads: int, delegate: str) -> None:
+        from ai_edge_litert import interpreter as litert
+
+        options: dict[str, Any] = {"num_threads": threads}
+        if delegate == "none":
+            options["experimental_op_resolver_type"] = (
+                litert.OpResolverType.BUILTIN_WITHOUT_DEFAULT_DELEGATES
+            )
+        try:
+            if delegate not in DELEGATES:
+                options["experimental_delegates"] = [_load_delegate(delegate)]
+            with filtered_native_stderr():
+                self._interpreter = litert.Interpreter(model_content=content, **options)
+                self._interpreter.allocate_tensors()
+        except (ValueError, RuntimeError, OSError) as exc:
+            raise ModelError(f"LiteRT cannot load {name}: {exc}") from None
+        details = self._interpreter.get_input_details()[0]
+        self.input_shape = tuple(int(n) for n in details["shape"])
+        self._input = self._interpreter.tensor(details["index"])
+        self._outputs = [d["index"] for d in self._interpreter.get_output_details()]
+
+    def run(
+        self, values: npt.NDArray[Any], scale: float = 1.0, offset: float = 0.0
+    ) -> list[npt.NDArray[np.float32]]:
+        """The outputs (copies, model order) for the input `values * scale + offset` of
+        `input_shape` without the batch, written straight into the interpreter's input."""
+        view = self._input()[0]
+        np.multiply(values, np.float32(scale), out=view, casting="unsafe")
+        if offset:
+            view += np.float32(offset)
+        del view  # LiteRT refuses to run while a view of its buffers is alive
+        self._interpreter.invoke()  # LiteRT releases Python's lock while it works
+        return [self._interpreter.get_tensor(index) for index in self._outputs]
+
+
+INTER_TAB_SIZE = 32
+"""Sub-pixel steps of OpenCV's fixed-point bilinear warp (INTER_BITS = 5)."""
+MAP_LIMIT = 1048000.0
+"""Source positions (in 1/32 px) beyond this are clipped, so the whole pixels fit in int16."""
+
+
+class Warper:
+    """A rotated region of an image on a square (`warp`), with its work buffers kept: fresh
+    half-megabyte arrays each frame cost more in page faults than the arithmetic. One thread at a
+    time; the returned image is overwritten by the next call."""
+
+    def __init__(self, side_px: int, border: int) -> None:
+        self.side_px, self._border = side_px, border
+        self._x, self._y, self._w = (np.empty((side_px, side_px)) for _ in range(3))
+        self._across = np.arange(side_px, dtype=np.float64)[None, :]
+        self._down = np.arange(side_px, dtype=np.float64)[:, None]
+        self._ix, self._iy = (
+            np.empty((side_px, side_px), np.int32),
+            np.empty((side_px, side_px), np.int32),
+        )
+        self._whole = np.empty((side_px, side_px, 2), np.int16)
+        self._fraction = np.empty((side_px, side_px), np.uint16)
+        self._out = np.empty((side_px, side_px, 3), np.uint8)
+
+    def _scaled_source(self, out: npt.NDArray[np.float64], row: npt.NDArray[np.float64]) -> bool:
+        """out[y, x] = 32 (row[0] x + row[1] y + row[2]) in one pass (times 32: exact in binary
+        floating point, so the same doubles as scaling afterwards); True when every value lies
+        within +-`MAP_LIMIT` (the extremes of a sum of a row and a column)."""
+        across = self._across * (INTER_TAB_SIZE * row[0])
+        down = self._down * (INTER_TAB_SIZE * row[1]) + INTER_TAB_SIZE * row[2]
+        np.add(down, across, out=out)
+        low, high = down.min() + across.min(), down.max() + across.max()
+        return bool(low >= -MAP_LIMIT and high <= MAP_LIMIT)
+
+    def warp(
+        self, rgb: npt.NDArray[np.uint8], roi: tuple[float, float, float, float, float]
+    ) -> npt.NDArray[np.uint8]:
+        """The rotated region `roi` (centre x, y, width, height px, degrees) of `rgb` on the
+        square, as MediaPipe's OpenCV converter makes it: `getPerspectiveTransform` of the
+        region's `boxPoints` onto the square's corners and `warpPerspective`, bilinear.
+
+        MediaPipe's own OpenCV samples at source positions rounded to 1/32 pixel and interpolates
+        in fixed point (OpenCV's classic `warpPerspective`); OpenCV >= 4.11 in Python interpolates
+        in floats, which moved the detector's keypoints by up to 0.4 px. So the source positions
+        are computed and rounded here as the classic code does, and `remap` interpolates them
+        with the fixed-point tables (measured equal to MediaPipe's detector to 4e-5 px).
+        """
+        import cv2
+
+        cx, cy, width, height, angle_deg = roi
+        corners = cv2.boxPoints(((cx, cy), (width, height), angle_deg)).astype(np.float32)
+        side = float(self.side_px)
+        target = np.array([[0, side], [0, 0], [side, 0], [side, side]], np.float32)
+        inverse = np.linalg.inv(cv2.getPerspectiveTransform(corners, target))
+        x, y, w = self._x, self._y, self._w
+        # The map is affine up to rounding (terms below 1e-18 leave w = 1 exactly in doubles).
+        if abs(inverse[2, 0]) < 1e-18 and abs(inverse[2, 1]) < 1e-18:
+            inside = self._scaled_source(x, inverse[0] / inverse[2, 2])
+            inside &= self._scaled_source(y, inverse[1] / inverse[2, 2])
+        else:
+            self._scaled_source(x, inverse[0])
+            self._scaled_source(y, inverse[1])
+            self._scaled_source(w, inverse[2])
+            np.divide(INTER_TAB_SIZE, w, out=w, where=w != 0)
+            x *= w
+            y *= w
+            inside = False
+        for value, rounded in ((x, self._ix), (y, self._iy)):
+            if not inside:
+                np.clip(value, -MAP_LIMIT, MAP_LIMIT, out=value)
+            np.rint(value, out=value)
+            rounded[...] = value
+        np.right_shift(self._ix, 5, out=self._whole[..., 0], casting="unsafe")
+        np.right_shift(self._iy, 5, out=self._whole[..., 1], casting="unsafe")
+        self._ix &= INTER_TAB_SIZE - 1
+        self._iy &= INTER_TAB_SIZE - 1
+        self._iy <<= 5
+        self._iy |= self._ix
+        self._fraction[...] = self._iy
+        cv2.remap(
+            rgb,
+            self._whole,
+            self._fraction,
+            cv2.INTER_LINEAR,
+            dst=self._out,
+            borderMode=self._border,
+        )
+        return self._out
+
+
+class FaceDetector:
+    """The bundle's short-range face detector: regions of the faces in an RGB image."""
+
+    def __init__(self, model: bytes, min_confidence: float, threads: int, delegate: str) -> None:
+        import cv2
+
+        self._model = _Model(model, DETECTOR_MEMBER, threads, delegate)
+        self._warper = Warper(graph.DETECTOR_SIZE, cv2.BORDER_CONSTANT)
+        self._anchors = graph.ssd_anchors()
+        self._min_confidence = min_confidence
+
+    def detect(self, rgb: npt.NDArray[np.uint8]) -> list[graph.FaceDetection]:
+        """Every face, best first, in image fractions."""
+        size = (rgb.shape[1], rgb.shape[0])
+        roi = graph.letterbox_roi(*size)
+        warped = self._warper.warp(rgb, (*roi, 0.0))
+        boxes, scores = self._model.run(warped, 2.0 / 255.0, -1.0)
+        found = graph.decode_detections(
+            boxes[0], scores[0, :, 0], self._anchors, self._min_confidence
+        )
+        return [graph.project_detection(face, roi, size) for face in found]
+
+    def count(self, rgb: npt.NDArray[np.uint8]) -> int:
+        """Faces in the image (the multi-face switch's check)."""
+        return len(self.detect(rgb))
+
+    def close(self) -> None:
+        """Nothing to release beyond the interpreter, which Python frees."""
+
+
+@dataclass(frozen=True, slots=True)
+class Models:
+    """The three models on interpreters of their own (one landmarker's)."""
+
+    detector: FaceDetector
+    landmarks: _Model
+    blendshapes: _Model
+
+    @classmethod
+    def load(cls, bundle: Bundle, settings: LandmarksConfig) -> Models:
+        """ModelError when LiteRT cannot load one of them."""
+        threads, delegate = settings.threads, settings.delegate
+        return cls(
+            FaceDetector(bundle.detector, settings.min_detection_confidence, threads, delegate),
+            _Model(bundle.landmarks, LANDMARKS_MEMBER, threads, delegate),
+            _Model(bundle.blendshapes, BLENDSHAPES_MEMBER, threads, delegate),
+        )
+
+
+class LiteRtFaceLandmarker:
+    """MediaPipe's FaceLandmarker (`num_faces`, IMAGE or VIDEO mode) on LiteRT: `run` gives what
+    `roadgaze.landmarks.results.run_landmarker` gives for MediaPipe's."""
+
+    def __init__(
+        self,
+        bundle: Bundle,
+        settings: LandmarksConfig,
+        num_faces: int,
+        video: bool,
+        models: Models | None = None,
+    ) -> None:
+        import cv2
+
+        models = models or Models.load(bundle, settings)
+        self._settings = settings
+        self._detector, self._landmarks = models.detector, models.landmarks
+        self._blendshapes = models.blendshapes
+        self._face = bundle.face
+        self._warper = Warper(LANDMARKS_SIZE, cv2.BORDER_REPLICATE)
+        self._num_faces = num_faces
+        self._video = video
+        self._tracked: list[graph.Rect] = []
+        self._smoother = graph.OneEuroSmoother() if video and num_faces == 1 else None
+
+    def run(self, rgb: npt.NDArray[np.uint8], timestamp_ms: int | None) -> list[FaceArrays]:
+        """Faces in the RGB image: normalised landmarks, the matrix and the blendshapes each."""
+        size = (rgb.shape[1], rgb.shape[0])
+        rects = self._tracked if self._video else []
+        if len(rects) < self._num_faces:
+            found = self._detector.detect(rgb)[: self._num_faces]
+            detected = [graph.detection_rect(face, size) for face in found]
+            rects = graph.associate(rects, detected, self._settings.min_tracking_confidence)
+        faces: list[npt.NDArray[np.float32]] = []
+        tracked: list[graph.Rect] = []
+        for rect in rects[: self._num_faces]:
+            roi = graph.roi_pixels(rect, size)
+            warped = self._warper.warp(rgb, roi)
+            outputs = self._landmarks.run(warped, 1.0 / 255.0)
+            presence = 1.0 / (1.0 + np.exp(-float(outputs[1].reshape(-1)[0])))
+            if presence <= self._settings.min_presence_confidence:
+                continue
+            points = graph.project_landmarks(outputs[0], LANDMARKS_SIZE, rect, size)
+            faces.append(points)
+            tracked.append(graph.landmarks_rect(points, size))
+        self._tracked = tracked
+        if self._smoother is not None:
+            if faces and timestamp_ms is not None:
+                scale = np.array([size[0], size[1], size[0]], np.float32)
+                smoothed = self._smoother.apply(timestamp_ms * 1000, faces[0] * scale)
+                faces[0] = (smoothed / scale).astype(np.float32)
+            else:
+                self._smoother.reset()
+        return [
+            (points, self._matrix(points, size), self._scores(points, size)) for points in faces
+        ]
+
+    def _matrix(
+        self, points: npt.NDArray[np.float32], size: tuple[int, int]
+    ) -> npt.NDArray[np.float64] | None:
+        return transformation_matrix(points, size, self._face)
+
+    def _scores(self, points: npt.NDArray[np.float32], size: tuple[int, int]) -> dict[str, float]:
+        subset = points[BLENDSHAPE_INDEX, :2] * np.array(size, np.float32)
+        scores = self._blendshapes.run(subset.astype(np.float32))[0].reshape(-1)
+        return {name: float(score) for name, score in zip(BLENDSHAPE_NAMES, scores, strict=True)}
+
+    def close(self) -> None:
+        self._tracked = []
+
+
+class LiteRtEngine:
+    """LiteRT landmarkers for the bundle at `model_path` (see the module docstring). Raises
+    ImportError without ai-edge-litert and ModelError for a bundle LiteRT cannot load (checked
+    here, by loading the first landmarker's models)."""
+
+    name = "litert"
+
+    def __init__(self, config: LandmarksConfig, model_path: Path, video: bool) -> None:
+        import ai_edge_litert.interpreter  # noqa: F401  (ImportError here, not mid-stream)
+
+        self._bundle = Bundle.read(model_path)
+        self._settings = config
+        self._video = video
+        self._spare: Models | None = Models.load(self._bundle, self._settings)
+
+    def image(self, rgb: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
+        """LiteRT reads the RGB array itself."""
+        return rgb
+
+    def landmarker(self, num_faces: int) -> LiteRtFaceLandmarker:
+        models, self._spare = self._spare, None
+        return LiteRtFaceLandmarker(self._bundle, self._settings, num_faces, self._video, models)
+
+    def counter(self) -> FaceDetector:
+        settings = self._settings
+        return FaceDetector(
+            self._bundle.detector,
+            settings.min_detection_confidence,
+            settings.threads,
+            settings.delegate,
+        )

@@ -1,0 +1,166 @@
+"""The per-driver eye calibration: running mean and noise against closed forms, the states in
+time (not frames), thresholds from the noise, no gaze from uncalibrated eyes, a biased driver kept
+on the road, an eyes-only glance still off road once calibrated, a sweeping head teaching
+nothing."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from fakes import eyes_of
+from roadgaze.config import MonitorConfig
+from roadgaze.monitor import Monitor
+from roadgaze.monitor.eye_calibration import (
+    EyeCalibration,
+    eye_shift_deg,
+    learn_calibration,
+    thresholds_deg,
+)
+from roadgaze.monitor.neutral import learn_neutral
+from roadgaze.monitor.state import initial_state
+from roadgaze.types import EyeCalibrationStatus, EyesFeatures, PoseSample
+
+CONFIG = MonitorConfig()
+FIXED = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=0.0)
+
+
+def test_the_running_mean_and_noise_are_the_weighted_mean_and_deviation() -> None:
+    rng = np.random.default_rng(5)
+    yaw, pitch = rng.normal(4.0, 2.0, 20), rng.normal(-20.0, 5.0, 20)
+    dts = rng.uniform(0.02, 0.2, 20)
+    calibration = EyeCalibration()
+    for y, p, dt in zip(yaw, pitch, dts, strict=True):
+        calibration = learn_calibration(CONFIG, calibration, float(y), float(p), float(dt))
+    weights = dts / dts.sum()
+    for axis, values, learned in ((0, yaw, calibration.yaw_deg), (1, pitch, calibration.pitch_deg)):
+        mean = float(np.sum(weights * values))
+        assert learned == pytest.approx(mean, abs=1e-9)
+        sd = float(np.sqrt(np.sum(weights * (values - mean) ** 2)))
+        assert calibration.noise_deg()[axis] == pytest.approx(sd, abs=1e-9)
+    assert calibration.learned_s == pytest.approx(float(dts.sum()))
+
+
+@pytest.mark.parametrize("fps", [5.0, 15.0, 60.0])
+def test_the_states_follow_the_learned_time_not_the_frame_count(fps: float) -> None:
+    config = MonitorConfig(eye_calibration_s=2.0)
+    calibration = EyeCalibration()
+    assert calibration.status() is EyeCalibrationStatus.NONE
+    t_s, states = 0.0, []
+    while t_s < 3.0:
+        calibration = learn_calibration(config, calibration, 1.0, -2.0, 1.0 / fps)
+        t_s += 1.0 / fps
+        states.append((t_s, calibration.status()))
+    calibrated_at = min(t for t, s in states if s is EyeCalibrationStatus.CALIBRATED)
+    assert calibrated_at == pytest.approx(2.0, abs=1.01 / fps)
+    assert all(s is EyeCalibrationStatus.LEARNING for t, s in states if t < calibrated_at)
+
+
+def test_thresholds_are_the_deadband_or_sigmas_times_the_noise() -> None:
+    quiet = EyeCalibration(yaw_sq_deg2=1.0 * 4.0, pitch_sq_deg2=1.0 * 4.0, learned_s=4.0)
+    assert thresholds_deg(CONFIG, quiet) == (10.0, 10.0)  # noise 1 deg: the deadband
+    noisy = EyeCalibration(yaw_sq_deg2=4.0 * 4.0, pitch_sq_deg2=25.0 * 4.0, learned_s=4.0)
+    assert thresholds_deg(CONFIG, noisy) == pytest.approx((10.0, 15.0))  # 3 x 5 deg in pitch
+
+
+def test_no_shift_until_calibrated_then_beyond_the_threshold_from_the_clamped_rest() -> None:
+    learning = EyeCalibration(yaw_deg=2.0, pitch_deg=-40.0, learned_s=1.0)
+    assert eye_shift_deg(CONFIG, learning, 30.0, -60.0) is None
+    calibrated = EyeCalibration(yaw_deg=2.0, pitch_deg=-40.0, learned_s=4.0, calibrated=True)
+    assert calibrated.resting_deg(CONFIG) == (2.0, -30.0)  # pitch clamped to 30
+    assert eye_shift_deg(CONFIG, calibrated, 30.0, -60.0) == pytest.approx((18.0, -20.0))
+    assert eye_shift_deg(CONFIG, calibrated, 8.0, -35.0) == (0.0, 0.0)
+    assert eye_shift_deg(CONFIG, calibrated, None, -35.0) is None
+
+
+def test_once_calibrated_the_noise_is_frozen_and_the_rest_follows_slowly() -> None:
+    config = MonitorConfig(eye_calibration_s=1.0)
+    calibration = EyeCalibration()
+    for _ in range(15):
+        calibration = learn_calibration(config, calibration, 0.0, 0.0, 0.1)
+    assert calibration.calibrated
+    before = thresholds_deg(config, calibration)
+    for _ in range(10):  # 1 s of glances 12 deg to the side (within the road)
+        calibration = learn_calibration(config, calibration, 12.0, 0.0, 0.1)
+    assert thresholds_deg(config, calibration) == before
+    assert calibration.yaw_deg == pytest.approx(12.0 * (1 - np.exp(-1.0 / 60.0)), rel=1e-6)
+
+
+def run(
+    script: list[tuple[float, EyesFeatures, float]], config: MonitorConfig = FIXED, fps: float = 15
+) -> tuple[Monitor, list[str], list[tuple[float, str | None, EyeCalibrationStatus]]]:
+    """Segments of (seconds, eyes, head yaw rate deg/s); returns the monitor, alert labels and
+    per-sample (t, zone, calibration)."""
+    monitor = Monitor(config)
+    labels, trace = [], []
+    t_s, frame = 0.0, 0
+    for duration_s, eyes, rate_dps in script:
+        for _ in range(round(duration_s * fps)):
+            sample = PoseSample(
+                t_s=t_s,
+                frame=frame,
+                face=True,
+                yaw_raw_deg=0.0,
+                yaw_deg=0.0,
+                yaw_rate_dps=rate_dps,
+                yaw_std_deg=1.0,
+                n_faces=1,
+                pitch_raw_deg=0.0,
+                pitch_deg=0.0,
+                eyes=eyes,
+            )
+            labels += [alert.label for alert in monitor.update(sample, None)]
+            verdict = monitor.verdict
+            trace.append((t_s, verdict.zone, verdict.eyes.calibration))
+            t_s, frame = t_s + 1 / fps, frame + 1
+    return monitor, labels, trace
+
+
+def test_uncalibrated_eyes_never_move_the_gaze() -> None:
+    lap_glance = eyes_of(eye_pitch=-40.0)  # calibration takes 3 s: still learning at 2.9 s
+    monitor, _, trace = run([(2.9, lap_glance, 0.0)])
+    assert {zone for _, zone, _ in trace} == {"road"}
+    assert trace[-1][2] is EyeCalibrationStatus.LEARNING
+    assert monitor.verdict.eyes.gaze_source == "head"
+    assert monitor.verdict.eyes.gaze_pitch_deg == 0.0
+
+
+def test_a_driver_whose_eyes_read_low_stays_on_the_road_and_a_glance_still_counts() -> None:
+    # Real faces read 13-26 deg downward looking ahead (docs/eyes.md): learned as the rest.
+    ahead, glance = eyes_of(eye_pitch=-25.0), eyes_of(eye_yaw=-32.0, eye_pitch=-25.0)
+    _, labels, trace = run([(6.0, ahead, 0.0), (4.0, glance, 0.0), (1.0, ahead, 0.0)])
+    states = [c for _, _, c in trace]
+    assert states[0] is EyeCalibrationStatus.NONE and states[1] is EyeCalibrationStatus.LEARNING
+    assert EyeCalibrationStatus.CALIBRATED in states
+    assert all(zone == "road" for t, zone, _ in trace if t < 6.0 - 1e-6)
+    assert labels == ["long_distraction:warning", "cleared:info"]
+
+
+def test_a_sweeping_head_teaches_neither_the_eyes_nor_the_neutral() -> None:
+    monitor, _, trace = run([(5.0, eyes_of(eye_pitch=-25.0), 150.0)], config=CONFIG)
+    assert trace[-1][2] is EyeCalibrationStatus.NONE
+    assert monitor.state.neutral_yaw_learned_s == 0.0
+    state = replace(initial_state(CONFIG), t_s=0.0)
+    fast = learn_neutral(CONFIG, state, -12.0, 10.0, 0.1, yaw_rate_dps=190.0)
+    steady = learn_neutral(CONFIG, state, -12.0, 10.0, 0.1, yaw_rate_dps=20.0)
+    assert fast == (0.0, 0.0, 0.0, 0.0)
+    assert steady[:2] == pytest.approx((-12.0, 10.0))
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("eye_calibration_s", 0.0),
+        ("eye_noise_sigmas", -1.0),
+        ("eye_neutral_pitch_limit_deg", -5.0),
+        ("neutral_max_rate_dps", 0.0),
+    ],
+)
+def test_bad_calibration_settings_are_refused_naming_the_key(key: str, value: float) -> None:
+    from pydantic import ValidationError
+
+    with pytest.raises(ValidationError, match=key):
+        MonitorConfig.model_validate({key: value})
+    assert MonitorConfig.model_validate({"neutral_max_rate_dps": None}).neutral_max_rate_dps is None

@@ -33,10 +33,6 @@ from roadgaze.evaluation.held_out import (
 )
 from zenoh_helpers import endpoint, free_port, router, stop_process, wait_for
 
-pytestmark = pytest.mark.skipif(
-    not (POINTING04 / "ground_truth.csv").is_file(),
-    reason=f"Pointing'04 development data not found under {POINTING04} (evaluation data)",
-)
 CASE = {case.name: case for case in CASES}
 IN_PROCESS = [
     (3, "left60_4s_70"),  # reads 47 deg: the left mirror (a stay of 2 s counts from its start)
@@ -51,7 +47,26 @@ OVER_THE_BUS = [(2, "left90_4s_70"), (1, "lap60_8s_10")]
 
 @pytest.fixture(scope="module")
 def stills() -> dict[int, Stills]:
+    if not (POINTING04 / "ground_truth.csv").is_file():
+        pytest.skip(f"Pointing'04 development data not found under {POINTING04} (evaluation data)")
     return {s.subject: s for s in load_stills(POINTING04) if s.series == 1}
+
+
+def test_the_verdict_of_a_case_from_its_alerts() -> None:
+    """The acceptance rule itself: a warning 1.5-3.6 s after the look starts (times on the clip's
+    timeline, the look at 4 s), or no alert but `cleared` on a look that must stay quiet."""
+    someone = Stills(0, 1, {})
+    zones, yaws = ["road"] * 120, [0.0] * 120
+
+    def verdict(name: str, alerts: list[tuple[float, str, str]]) -> str:
+        return result_of(someone, CASE[name], 4.0, alerts, zones, yaws).why_failed
+
+    assert verdict("left75_4s_70", [(7.0, "long_distraction", ""), (8.0, "cleared", "")]) == ""
+    assert verdict("left75_4s_70", [(7.7, "long_distraction", "")]) == "warned at 3.70 s"
+    assert verdict("left75_4s_70", [(5.0, "long_distraction", "")]) == "warned at 1.00 s"
+    assert verdict("left75_4s_70", [(6.0, "driver_unavailable", "")]) == "no warning"
+    assert verdict("lap60_8s_10", [(9.0, "cleared", "")]) == ""
+    assert verdict("left_mirror45_1.5s_70", [(5.0, "vats", "")]) == "raised vats"
 
 
 def check(result: CaseResult) -> None:

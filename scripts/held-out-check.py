@@ -19,9 +19,13 @@ from pathlib import Path
 
 from roadgaze.config import Config, load_config
 from roadgaze.evaluation.held_out import CASES, Case, CaseResult, Stills, load_stills, run_case
+from roadgaze.evaluation.pointing04 import default_dataset
 from roadgaze.logs import setup_logging
 
-DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "pointing04-dev"
+# $ROADGAZE_DATA/pointing04-dev, else the evaluation data beside the checkout (as tests find it).
+DEFAULT_DATA = default_dataset() or (
+    Path(__file__).resolve().parents[1].parent / "shared" / "data" / "pointing04-dev"
+)
 
 
 def _run(job: tuple[Stills, Case, Config]) -> CaseResult:

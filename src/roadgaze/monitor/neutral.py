@@ -12,9 +12,8 @@ __all__ = ["learn_neutral"]
 _MAX_LEARNING_STEP_S = 1.0
 """A longer gap between samples teaches the neutral pose no more than one second would."""
 SETTLE_S = 1.0
-"""For its first second of learning the neutral also learns from samples judged off the road."""
-_PITCH_SETTLED_S = 1.0
-"""After this much learning, only a pitch within the road's entry band of the neutral teaches."""
+"""For its first second of learning the neutral also learns from samples judged off the road, and
+(the pitch's own second) from a pitch outside the road's entry band of the neutral."""
 
 
 def _learn(value: float, neutral: float, gain: float, limit: float) -> float:
@@ -56,10 +55,10 @@ def learn_neutral(
         return yaw, pitch, yaw_s, pitch_s
     ahead = abs(yaw_deg - yaw) <= config.road_half_width_deg - config.hysteresis_deg
     level = pitch_deg is None or abs(pitch_deg) <= config.neutral_pitch_limit_deg
-    if pitch_deg is not None and pitch_s >= _PITCH_SETTLED_S:
+    if pitch_deg is not None and pitch_s >= SETTLE_S:
         # Settled: a look into the lap (Pointing'04 tilt -60 reads -19 at first) held for
         # seconds would otherwise walk the neutral down after it until the lap read as road
-        # (subjects 7 and 8 of scripts/addw-real-faces.py: no warning in a 4 s lap look).
+        # (subjects 7 and 8, scripts/held-out-check.py's lap60 case: no warning in 4 s).
         low_deg, high_deg = config.road_pitch_deg
         level = level and low_deg <= pitch_deg - pitch <= high_deg
     limit = config.neutral_max_rate_dps

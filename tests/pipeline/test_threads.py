@@ -198,8 +198,12 @@ def test_the_decode_thread_runs_at_a_lower_priority() -> None:
 
 
 def test_a_loop_sets_the_interpreter_and_restores_it_after_the_last_loop() -> None:
+    import cv2
+
     switch_s, threshold = sys.getswitchinterval(), gc.get_threshold()
+    cv2.setNumThreads(2)
     with loop_runtime():
+        assert cv2.getNumThreads() == 1
         assert sys.getswitchinterval() == pytest.approx(min(switch_s, SWITCH_INTERVAL_S))
         assert gc.get_threshold()[0] == max(threshold[0], YOUNG_THRESHOLD)
         assert gc.get_freeze_count() > 0
@@ -209,6 +213,7 @@ def test_a_loop_sets_the_interpreter_and_restores_it_after_the_last_loop() -> No
     assert sys.getswitchinterval() == pytest.approx(switch_s)
     assert gc.get_threshold() == threshold
     assert gc.get_freeze_count() == 0
+    assert cv2.getNumThreads() == 2
 
 
 def test_garbage_is_collected_between_frames_the_generations_in_turn() -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 from roadgaze.benchmark.engines import EnginePass, compare_engines, format_engines
 from roadgaze.benchmark.raw import RawResult
 
@@ -33,3 +35,28 @@ def test_rounds_interleave_and_ratios_use_the_raw_passes_around_them() -> None:
     assert result["raw"]["passes_fps"] == [100.0, 50.0, 100.0]
     text = "\n".join(format_engines(result))
     assert "litert" in text and "x0.8 of raw" in text
+
+
+def test_the_models_alone_follow_each_raw_pass_and_are_read_against_it() -> None:
+    calls: list[str] = []
+    raw_cpu_s = itertools.cycle([0.10, 0.20])  # 10 frames: 10 and 20 ms of CPU a frame
+
+    def raw_pass() -> RawResult:
+        calls.append("raw")
+        return RawResult(tuple([0.01] * 10), cpu_s=next(raw_cpu_s), passes_fps=(100.0,))
+
+    def models_pass() -> RawResult:
+        calls.append("models")
+        return RawResult(tuple([0.005] * 10), cpu_s=0.06, passes_fps=(200.0,))
+
+    def engine_pass(name: str) -> EnginePass:
+        calls.append(name)
+        return EnginePass(50.0, 10.0, {}, name)
+
+    result = compare_engines(1, engine_pass, raw_pass, models_pass)
+    assert calls == ["raw", "models", "litert", "mediapipe", "raw", "models"]
+    # 6 ms a frame against 10 and against 20: ratios 0.6 and 0.3, median 0.45.
+    assert result["models"]["cpu_ms_per_frame"] == 6.0
+    assert result["models"]["cpu_ratio_to_raw"] == 0.45
+    assert "models alone" in "\n".join(format_engines(result))
+    assert "models" not in compare_engines(1, engine_pass, raw_pass)

@@ -5,6 +5,11 @@ against pass: each round runs a raw MediaPipe pass, then one pipeline pass per e
 alternating from round to round), and a last raw pass closes the run. Each engine's figures are
 the medians over its passes; `ratio_to_raw` and `cpu_ratio_to_raw` compare every pass with the
 mean of the raw passes just before and after its round. The load average is reported beside them.
+
+With a `models_pass`, each raw pass is followed by one of the bundle's landmark and blendshape
+models alone on LiteRT (`roadgaze.benchmark.raw.litert_models_pass`): the CPU no engine of these
+models can go below, as a share of FaceLandmarker's (`models.cpu_ratio_to_raw`, each models pass
+against the raw pass just before it).
 """
 
 from __future__ import annotations
@@ -51,17 +56,27 @@ def compare_engines(
     rounds: int,
     pipeline_pass: Callable[[str], EnginePass],
     raw_pass: Callable[[], RawResult],
+    models_pass: Callable[[], RawResult] | None = None,
 ) -> dict[str, Any]:
-    """`rounds` rounds of [raw, one pass per engine], then a last raw pass; the result's
-    `engines` maps each engine to its medians and ratios, `raw` is FaceLandmarker alone."""
+    """`rounds` rounds of [raw, (models,) one pass per engine], then a last raw (and models)
+    pass; the result's `engines` maps each engine to its medians and ratios, `raw` is
+    FaceLandmarker alone, `models` (with `models_pass`) the models alone."""
     load_start = load_average()
-    raws = [raw_pass()]
+    raws: list[RawResult] = []
+    models: list[RawResult] = []
+
+    def reference_passes() -> None:
+        raws.append(raw_pass())
+        if models_pass is not None:
+            models.append(models_pass())
+
+    reference_passes()
     passes: dict[str, list[tuple[EnginePass, int]]] = {name: [] for name in ENGINES}
     for number in range(rounds):
         order = ENGINES if number % 2 == 0 else tuple(reversed(ENGINES))
         for name in order:
             passes[name].append((pipeline_pass(name), number))
-        raws.append(raw_pass())
+        reference_passes()
     raw = sum(raws[1:], raws[0])
     engines: dict[str, Any] = {}
     for name, results in passes.items():
@@ -91,7 +106,7 @@ def compare_engines(
                 for stage in stage_names
             },
         }
-    return {
+    summary: dict[str, Any] = {
         "rounds": rounds,
         "load_average_start": load_start,
         "load_average_end": load_average(),
@@ -102,6 +117,16 @@ def compare_engines(
         },
         "engines": engines,
     }
+    if models:
+        ratios = [
+            m.cpu_ms_per_frame / r.cpu_ms_per_frame for m, r in zip(models, raws, strict=True)
+        ]
+        summary["models"] = {
+            "cpu_ms_per_frame": _round(_median([m.cpu_ms_per_frame for m in models])),
+            "cpu_ratio_to_raw": _round(_median(ratios), 4),
+            "passes_cpu_ms_per_frame": [_round(m.cpu_ms_per_frame) for m in models],
+        }
+    return summary
 
 
 def format_engines(result: dict[str, Any]) -> list[str]:
@@ -118,5 +143,12 @@ def format_engines(result: dict[str, Any]) -> list[str]:
             f"  {name:<10} {figures['fps']} fps, {figures['cpu_ms_per_frame']} ms CPU/frame "
             f"(fps x{figures['fps_ratio_to_raw']} of raw, CPU x{figures['cpu_ratio_to_raw']}); "
             f"landmarks median {landmarks.get('median_ms')} ms, p99 {landmarks.get('p99_ms')} ms"
+        )
+    models = result.get("models")
+    if models is not None:
+        lines.append(
+            f"  models alone (LiteRT, landmarks + blendshapes) {models['cpu_ms_per_frame']} ms "
+            f"CPU/frame (CPU x{models['cpu_ratio_to_raw']} of raw): no engine of these models "
+            "costs less"
         )
     return lines

@@ -1,4 +1,5 @@
-"""MediaPipe's FaceLandmarker alone on a clip: the throughput roadgaze's loop is compared with.
+"""MediaPipe's FaceLandmarker alone on a clip: the throughput roadgaze's loop is compared with;
+and the models inside it alone on LiteRT: the floor of any engine that runs them.
 
 The reference is what a user would measure with MediaPipe and nothing else: VIDEO mode,
 `num_faces=1`, MediaPipe's default outputs (no transformation matrices, no blendshapes), the
@@ -117,6 +118,45 @@ def raw_mediapipe_pass(
     finally:
         with filtered_native_stderr():
             landmarker.close()
+    fps = len(durations_s) / sum(durations_s) if durations_s else 0.0
+    return RawResult(tuple(durations_s), cpu_s, (fps,))
+
+
+def litert_models_pass(
+    frames: Iterable[Frame], model_path: Path, config: LandmarksConfig, warmup: int
+) -> RawResult:
+    """Time the bundle's landmark and blendshape models alone on LiteRT, once each per frame of
+    `frames` (the first `warmup` frames not timed), as a tracked frame runs them: the landmark
+    model on the frame's central square (cropped untimed), the blendshape model on the subset
+    of its landmarks. Nothing else a frame needs (decoding, the crop, the face's measurements) is
+    timed, so no engine of these models can cost less CPU. Raises ModelError for a bundle LiteRT
+    cannot load and ImportError without ai-edge-litert."""
+    import cv2
+
+    from roadgaze.landmarks.engines.litert import (
+        BLENDSHAPE_INDEX,
+        LANDMARKS_SIZE,
+        Bundle,
+        Models,
+        Warper,
+    )
+
+    models = Models.load(Bundle.read(model_path), config)
+    warper = Warper(LANDMARKS_SIZE, cv2.BORDER_REPLICATE)
+    durations_s: list[float] = []
+    cpu_s = 0.0
+    for position, frame in enumerate(frames):
+        height, width = frame.image.shape[:2]
+        side = float(min(width, height))
+        rgb = np.ascontiguousarray(cv2.cvtColor(frame.image, cv2.COLOR_BGR2RGB), np.uint8)
+        crop = warper.warp(rgb, (width / 2.0, height / 2.0, side, side, 0.0))
+        cpu_before, before = time.process_time(), time.perf_counter()
+        points = models.landmarks.run(crop, 1.0 / 255.0)[0].reshape(-1, 3)
+        models.blendshapes.run(np.ascontiguousarray(points[BLENDSHAPE_INDEX, :2]))
+        elapsed_s, cpu_elapsed_s = time.perf_counter() - before, time.process_time() - cpu_before
+        if position >= warmup:
+            durations_s.append(elapsed_s)
+            cpu_s += cpu_elapsed_s
     fps = len(durations_s) / sum(durations_s) if durations_s else 0.0
     return RawResult(tuple(durations_s), cpu_s, (fps,))
 

@@ -117,6 +117,26 @@ def raw_pass(args: argparse.Namespace, config: Config, number: int, count: int) 
         )
 
 
+def litert_available() -> bool:
+    """Whether ai-edge-litert is installed (`bench --engines` then times the models alone)."""
+    import importlib.util
+
+    return importlib.util.find_spec("ai_edge_litert") is not None
+
+
+def models_pass(args: argparse.Namespace, config: Config) -> RawResult:
+    """One pass of the bundle's models alone on LiteRT over the source's frames."""
+    from roadgaze.benchmark.raw import litert_models_pass
+    from roadgaze.capture import open_source
+    from roadgaze.landmarks.model_store import resolve_model
+
+    log.info("models-alone pass (LiteRT)")
+    with open_source(args.source, config) as source:
+        return litert_models_pass(
+            source, resolve_model(config.model), config.landmarks, args.warmup
+        )
+
+
 @dataclass(frozen=True, slots=True)
 class PassResult:
     """One timed pass of the pipeline."""
@@ -208,7 +228,10 @@ def engines_run(args: argparse.Namespace, config: Config) -> int:
 
     raws = iter(range(1, args.repeat + 2))
     result = compare_engines(
-        args.repeat, engine_pass, lambda: raw_pass(args, config, next(raws), args.repeat + 1)
+        args.repeat,
+        engine_pass,
+        lambda: raw_pass(args, config, next(raws), args.repeat + 1),
+        (lambda: models_pass(args, config)) if litert_available() else None,
     )
     result = {"source": args.source, "default_engine": config.landmarks.engine, **result}
     print(json.dumps(result) if args.json else "\n".join(format_engines(result)))

@@ -140,7 +140,8 @@ def _quantiles_10_90(values: npt.NDArray[Any]) -> tuple[float, float]:
     """`np.quantile(values.astype(float64), [0.1, 0.9])`, bit for bit: numpy's default (linear)
     method, its virtual index (n - 1) q and its interpolation formula, on a partition at the four
     ranks needed. np.quantile's generic path costs 50 times as much on a few hundred pixels.
-    NaN pixels (a float image) give NaN, as in np.quantile."""
+    NaN pixels (a float image) give NaN, as in np.quantile. Partitions `values` in place (the
+    caller's own copy)."""
     count = values.size
     ranks = []
     for q in (0.1, 0.9):
@@ -148,12 +149,12 @@ def _quantiles_10_90(values: npt.NDArray[Any]) -> tuple[float, float]:
         below = math.floor(index)
         ranks.append((below, index - below))
     kth = [r for below, _ in ranks for r in (below, below + 1)]
-    part = np.partition(values, [*kth, count - 1])  # the last rank: NaN sorts there
-    if math.isnan(float(part[-1])):
+    values.partition([*kth, count - 1])  # the last rank: NaN sorts there
+    if math.isnan(float(values[-1])):
         return math.nan, math.nan
     result = []
     for below, gamma in ranks:
-        a, b = float(part[below]), float(part[below + 1])
+        a, b = float(values[below]), float(values[below + 1])
         difference = b - a
         # numpy's _lerp: from the nearer end, so that gamma 0 or 1 gives an end exactly.
         result.append(b - difference * (1 - gamma) if gamma >= 0.5 else a + difference * gamma)
@@ -178,12 +179,13 @@ def _median(values: npt.NDArray[Any]) -> float:
     much; other dtypes take np.median itself."""
     if values.dtype.kind not in "ui":
         return float(np.median(values))
-    flat = values.ravel()
+    flat = values.flatten()  # a copy, partitioned in place
     middle = flat.size // 2
     if flat.size % 2:
-        return float(np.partition(flat, middle)[middle])
-    part = np.partition(flat, [middle - 1, middle])
-    return (int(part[middle - 1]) + int(part[middle])) / 2
+        flat.partition(middle)
+        return float(flat[middle])
+    flat.partition([middle - 1, middle])
+    return (int(flat[middle - 1]) + int(flat[middle])) / 2
 
 
 def _sharpness(image: npt.NDArray[Any], outline: _Outline) -> float:
@@ -204,5 +206,6 @@ def _sharpness(image: npt.NDArray[Any], outline: _Outline) -> float:
         cv2.Sobel(crop, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(crop, cv2.CV_32F, 0, 1, ksize=3)
     ).ravel()
     rank = int(0.9 * (magnitude.size - 1))  # the 90th percentile, lower value (no interpolation)
-    edge = float(np.partition(magnitude, rank)[rank])
+    magnitude.partition(rank)
+    edge = float(magnitude[rank])
     return edge / _skin_reference(image, outline, x0, x1)

@@ -110,7 +110,10 @@ def boundaries_and_center(
     When fewer than two landmarks fall in the height band (a degenerate face), the band is
     ignored rather than failing.
     """
-    x_center = float(np.mean(upright_px[list(choice.center_landmarks), 0]))
+    # np.mean's own sum and division without its generic path (for float32 too: a float64
+    # quotient rounded to float32 is the float32 quotient).
+    centers = upright_px[list(choice.center_landmarks), 0]
+    x_center = float(centers.sum() / len(centers))
     candidates = (
         upright_px
         if choice.boundary_landmarks is None

@@ -12,6 +12,7 @@ docs/eyes.md.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -50,7 +51,43 @@ def _fill_polygon(polygon: FloatArray, shape: tuple[int, int]) -> npt.NDArray[np
     mask = np.zeros(shape, dtype=np.uint8)
     vertices = np.round((polygon - 0.5) * 16).astype(np.int32)
     cv2.fillPoly(mask, [vertices], 1, lineType=cv2.LINE_8, shift=4)
-    return mask.astype(bool)
+    return mask.view(np.bool_)  # the 0/1 bytes as booleans, without a copy
+
+
+@dataclass(frozen=True, slots=True)
+class _Outline:
+    """One eye's opening in the image, measured once for both checks."""
+
+    polygon: FloatArray
+    """(16, 2) x, y of `EyeIndices.contour`, pixels, float64."""
+    width_px: float
+    """Outer to inner corner."""
+    low: tuple[float, float]
+    """The polygon's minimum x and y."""
+    high: tuple[float, float]
+    """Its maximum x and y."""
+    lower_lid_y: float
+    """The lowest y of the lower lid (the skin band is measured from it)."""
+
+
+def _outline(landmarks_px: npt.ArrayLike, eye: EyeIndices) -> _Outline:
+    """The eye's polygon and width from the 478 landmarks.
+
+    Only the eye's 18 rows are taken and converted to float64 (converting all 478 first, as a
+    plain `np.asarray(..., float64)` would, costs more than the rest of this function).
+    """
+    rows = np.asarray(landmarks_px)[np.array((*eye.contour, eye.outer, eye.inner)), :2]
+    points = rows.astype(np.float64)
+    polygon = points[:-2]
+    corners = points[-2] - points[-1]
+    low, high = polygon.min(axis=0), polygon.max(axis=0)
+    return _Outline(
+        polygon=polygon,
+        width_px=math.sqrt(corners.dot(corners)),  # np.linalg.norm's arithmetic, without its checks
+        low=(float(low[0]), float(low[1])),
+        high=(float(high[0]), float(high[1])),
+        lower_lid_y=float(polygon[9:, 1].max()),
+    )
 
 
 def eye_contrast(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndices) -> float:
@@ -61,37 +98,7 @@ def eye_contrast(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndic
     `gray`: a 2-D uint8 or float image. NaN when the eye is narrower than `MIN_EYE_WIDTH_PX` or
     off the image.
     """
-    image: npt.NDArray[Any] = np.asarray(gray)
-    points = np.asarray(landmarks_px, dtype=np.float64)[:, :2]
-    polygon = points[list(eye.contour)]
-    width = float(np.linalg.norm(points[eye.outer] - points[eye.inner]))
-    x0 = max(0, math.floor(float(polygon[:, 0].min())))
-    x1 = min(image.shape[1], math.ceil(float(polygon[:, 0].max())) + 1)
-    y0 = max(0, math.floor(float(polygon[:, 1].min())))
-    y1 = min(image.shape[0], math.ceil(float(polygon[:, 1].max())) + 1)
-    if x1 - x0 < 4 or y1 - y0 < 2 or width < MIN_EYE_WIDTH_PX:
-        return math.nan
-    mask = _fill_polygon(polygon - np.array([x0, y0]), (y1 - y0, x1 - x0))
-    values = image[y0:y1, x0:x1][mask].astype(np.float64)
-    if values.size < 6:
-        return math.nan
-    reference = _skin_reference(image, polygon, width, x0, x1)
-    p10, p90 = np.quantile(values, [0.1, 0.9])
-    return float((p90 - p10) / reference)
-
-
-def _skin_reference(
-    image: npt.NDArray[Any], polygon: FloatArray, width: float, x0: int, x1: int
-) -> float:
-    """The median of the skin below the eye (a band 0.35-0.6 eye widths below the lower lid, as
-    wide as the eye), at least 1; NaN when the band is off the image."""
-    lower_y = float(polygon[9:, 1].max())
-    skin_y0 = max(0, int(lower_y + 0.35 * width))
-    skin_y1 = min(image.shape[0], int(lower_y + 0.6 * width) + 1)
-    skin = image[skin_y0:skin_y1, x0:x1]
-    if skin.size == 0:
-        return math.nan
-    return max(float(np.median(skin)), 1.0)
+    return _contrast(np.asarray(gray), _outline(landmarks_px, eye))
 
 
 def eye_sharpness(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndices) -> float:
@@ -101,23 +108,104 @@ def eye_sharpness(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndi
     under strong motion blur or glare (docs/eyes.md). NaN when the eye is narrower than
     `MIN_EYE_WIDTH_PX` or off the image.
     """
+    return _sharpness(np.asarray(gray), _outline(landmarks_px, eye))
+
+
+def eye_checks(
+    gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndices
+) -> tuple[float, float]:
+    """(`eye_contrast`, `eye_sharpness`) of one eye, its outline measured once."""
+    image: npt.NDArray[Any] = np.asarray(gray)
+    outline = _outline(landmarks_px, eye)
+    return _contrast(image, outline), _sharpness(image, outline)
+
+
+def _contrast(image: npt.NDArray[Any], outline: _Outline) -> float:
+    x0 = max(0, math.floor(outline.low[0]))
+    x1 = min(image.shape[1], math.ceil(outline.high[0]) + 1)
+    y0 = max(0, math.floor(outline.low[1]))
+    y1 = min(image.shape[0], math.ceil(outline.high[1]) + 1)
+    if x1 - x0 < 4 or y1 - y0 < 2 or outline.width_px < MIN_EYE_WIDTH_PX:
+        return math.nan
+    mask = _fill_polygon(outline.polygon - np.array([x0, y0]), (y1 - y0, x1 - x0))
+    values = image[y0:y1, x0:x1][mask]
+    if values.size < 6:
+        return math.nan
+    reference = _skin_reference(image, outline, x0, x1)
+    p10, p90 = _quantiles_10_90(values)
+    return (p90 - p10) / reference
+
+
+def _quantiles_10_90(values: npt.NDArray[Any]) -> tuple[float, float]:
+    """`np.quantile(values.astype(float64), [0.1, 0.9])`, bit for bit: numpy's default (linear)
+    method, its virtual index (n - 1) q and its interpolation formula, on a partition at the four
+    ranks needed. np.quantile's generic path costs 50 times as much on a few hundred pixels.
+    NaN pixels (a float image) give NaN, as in np.quantile. Partitions `values` in place (the
+    caller's own copy)."""
+    count = values.size
+    ranks = []
+    for q in (0.1, 0.9):
+        index = (count - 1) * q
+        below = math.floor(index)
+        ranks.append((below, index - below))
+    kth = [r for below, _ in ranks for r in (below, below + 1)]
+    values.partition([*kth, count - 1])  # the last rank: NaN sorts there
+    if math.isnan(float(values[-1])):
+        return math.nan, math.nan
+    result = []
+    for below, gamma in ranks:
+        a, b = float(values[below]), float(values[below + 1])
+        difference = b - a
+        # numpy's _lerp: from the nearer end, so that gamma 0 or 1 gives an end exactly.
+        result.append(b - difference * (1 - gamma) if gamma >= 0.5 else a + difference * gamma)
+    return result[0], result[1]
+
+
+def _skin_reference(image: npt.NDArray[Any], outline: _Outline, x0: int, x1: int) -> float:
+    """The median of the skin below the eye (a band 0.35-0.6 eye widths below the lower lid,
+    columns `x0:x1`), at least 1; NaN when the band is off the image."""
+    lower_y, width = outline.lower_lid_y, outline.width_px
+    skin_y0 = max(0, int(lower_y + 0.35 * width))
+    skin_y1 = min(image.shape[0], int(lower_y + 0.6 * width) + 1)
+    skin = image[skin_y0:skin_y1, x0:x1]
+    if skin.size == 0:
+        return math.nan
+    return max(_median(skin), 1.0)
+
+
+def _median(values: npt.NDArray[Any]) -> float:
+    """`np.median(values)`. For integer grey levels by a partition at the middle rank(s): the
+    mean of two integers is exact in floats, and np.median's generic path costs four times as
+    much; other dtypes take np.median itself."""
+    if values.dtype.kind not in "ui":
+        return float(np.median(values))
+    flat = values.flatten()  # a copy, partitioned in place
+    middle = flat.size // 2
+    if flat.size % 2:
+        flat.partition(middle)
+        return float(flat[middle])
+    flat.partition([middle - 1, middle])
+    return (int(flat[middle - 1]) + int(flat[middle])) / 2
+
+
+def _sharpness(image: npt.NDArray[Any], outline: _Outline) -> float:
     import cv2
 
-    image: npt.NDArray[Any] = np.asarray(gray)
-    points = np.asarray(landmarks_px, dtype=np.float64)[:, :2]
-    polygon = points[list(eye.contour)]
-    width = float(np.linalg.norm(points[eye.outer] - points[eye.inner]))
-    pad = 0.15 * width
-    x0 = max(0, math.floor(float(polygon[:, 0].min()) - pad))
-    x1 = min(image.shape[1], math.ceil(float(polygon[:, 0].max()) + pad) + 1)
-    y0 = max(0, math.floor(float(polygon[:, 1].min()) - pad))
-    y1 = min(image.shape[0], math.ceil(float(polygon[:, 1].max()) + pad) + 1)
-    if x1 - x0 < 4 or y1 - y0 < 4 or width < MIN_EYE_WIDTH_PX:
+    pad = 0.15 * outline.width_px
+    x0 = max(0, math.floor(outline.low[0] - pad))
+    x1 = min(image.shape[1], math.ceil(outline.high[0] + pad) + 1)
+    y0 = max(0, math.floor(outline.low[1] - pad))
+    y1 = min(image.shape[0], math.ceil(outline.high[1] + pad) + 1)
+    if x1 - x0 < 4 or y1 - y0 < 4 or outline.width_px < MIN_EYE_WIDTH_PX:
         return math.nan
-    crop = image[y0:y1, x0:x1].astype(np.float32)
+    crop = image[y0:y1, x0:x1]
+    if crop.dtype != np.uint8:
+        # A uint8 crop goes to Sobel as it is: its sums are small integers, exact in float32.
+        crop = crop.astype(np.float32)
     magnitude = cv2.magnitude(
         cv2.Sobel(crop, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(crop, cv2.CV_32F, 0, 1, ksize=3)
     ).ravel()
     rank = int(0.9 * (magnitude.size - 1))  # the 90th percentile, lower value (no interpolation)
-    edge = float(np.partition(magnitude, rank)[rank])
-    return edge / _skin_reference(image, polygon, width, x0, x1)
+    magnitude.partition(rank)
+    edge = float(magnitude[rank])
+    return edge / _skin_reference(image, outline, x0, x1)

@@ -13,6 +13,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy as np
+
 from roadgaze.landmarks.features import LEFT_EYE_OUTER, RIGHT_EYE_OUTER
 from roadgaze.types import FloatArray
 
@@ -92,7 +94,7 @@ EYE_LANDMARKS = tuple(
     )
 )
 """The landmarks `eye_features` measures (corners, lids, iris centres; the eye line's ends)."""
-EYE_LANDMARKS_LIST = list(EYE_LANDMARKS)
+_EYE_ROWS = np.array(EYE_LANDMARKS)
 _RIGHT_OUTER_ROW = EYE_LANDMARKS.index(RIGHT_EYE_OUTER)
 _LEFT_OUTER_ROW = EYE_LANDMARKS.index(LEFT_EYE_OUTER)
 
@@ -119,7 +121,8 @@ def eye_width_px(upright_px: UprightPoints, eye: EyeIndices) -> float:
 def upright_eye_points(points: FloatArray, roll_deg: float) -> dict[int, tuple[float, float]]:
     """The roll-removed (x, y) of the landmarks the eye measures use (`EYE_LANDMARKS`), by index:
     `remove_roll` on those points only, in plain floats."""
-    rows: list[list[float]] = points[EYE_LANDMARKS_LIST, :2].tolist()
+    # `take` with a ready index array: fancy indexing with a list converts the list every call.
+    rows: list[list[float]] = points.take(_EYE_ROWS, axis=0)[:, :2].tolist()
     pivot_x = 0.5 * (rows[_RIGHT_OUTER_ROW][0] + rows[_LEFT_OUTER_ROW][0])
     pivot_y = 0.5 * (rows[_RIGHT_OUTER_ROW][1] + rows[_LEFT_OUTER_ROW][1])
     angle = math.radians(roll_deg)

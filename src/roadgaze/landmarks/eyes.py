@@ -221,9 +221,12 @@ def eye_features(
     points = np.asarray(landmarks_px, dtype=np.float64)
     if points.ndim != 2 or points.shape[0] != NUM_LANDMARKS or points.shape[1] not in (2, 3):
         raise ValueError(f"expected ({NUM_LANDMARKS}, 2|3) landmarks, found shape {points.shape}")
-    if not np.all(np.isfinite(points[:, :2])):
+    # x, y copied together first: np.isfinite on the contiguous copy is several times faster than
+    # on the strided columns.
+    xy_px = np.ascontiguousarray(points[:, :2])
+    if not np.isfinite(xy_px).all():
         raise ValueError("landmarks contain NaN or infinite values")
-    upright = upright_eye_points(points, roll_from_eyes_deg(points))
+    upright = upright_eye_points(xy_px, roll_from_eyes_deg(xy_px))
     widths = {e.side: eye_width_px(upright, e) for e in EYES}
     scale = max(widths.values())
     yaw = None if head_yaw_deg is None or not math.isfinite(head_yaw_deg) else head_yaw_deg

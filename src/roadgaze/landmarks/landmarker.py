@@ -13,7 +13,7 @@ no state). `detect` is the three in a row.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -23,13 +23,14 @@ import numpy.typing as npt
 from roadgaze.config import Config, LandmarksConfig
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored
 from roadgaze.landmarks.engines import FaceCounting, FaceRunner, open_engine
-from roadgaze.landmarks.eye_contrast import eye_contrast, eye_sharpness
+from roadgaze.landmarks.eye_contrast import eye_checks
 from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
 from roadgaze.landmarks.features import (
     DEFAULT_CHOICE,
     NUM_LANDMARKS,
     LandmarkChoice,
     features_from_landmarks,
+    finite_box_px,
 )
 from roadgaze.landmarks.multi_face import BackgroundCount, FaceMode, MultiFaceSwitch
 from roadgaze.landmarks.native_log import filtered_native_stderr
@@ -322,11 +323,11 @@ class Landmarker(ClosesOnExit):
         faces: list[FoundFace] = []
         for points, matrix, blendshapes in results:
             pixels = points * scale
-            if pixels.shape != (NUM_LANDMARKS, 3) or not np.isfinite(pixels).all():
+            if pixels.shape != (NUM_LANDMARKS, 3):
                 continue
-            low, high = pixels[:, :2].min(axis=0), pixels[:, :2].max(axis=0)
-            box = (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
-            faces.append(FoundFace(pixels, matrix, blendshapes, box))
+            box = finite_box_px(pixels)
+            if box is not None:
+                faces.append(FoundFace(pixels, matrix, blendshapes, box))
         return faces
 
     def _features(
@@ -338,18 +339,17 @@ class Landmarker(ClosesOnExit):
         faces: list[FaceFeatures] = []
         for face in found:
             pixels = face.landmarks_px
-            features = features_from_landmarks(pixels, size, face.matrix, self._choice)
-            contrast = (eye_contrast(gray, pixels, RIGHT_EYE), eye_contrast(gray, pixels, LEFT_EYE))
-            sharpness = (
-                eye_sharpness(gray, pixels, RIGHT_EYE),
-                eye_sharpness(gray, pixels, LEFT_EYE),
-            )
+            right_contrast, right_sharpness = eye_checks(gray, pixels, RIGHT_EYE)
+            left_contrast, left_sharpness = eye_checks(gray, pixels, LEFT_EYE)
             faces.append(
-                replace(
-                    features,
+                features_from_landmarks(
+                    pixels,
+                    size,
+                    face.matrix,
+                    self._choice,
                     blendshapes=face.blendshapes,
-                    eye_contrast=contrast,
-                    eye_sharpness=sharpness,
+                    eye_contrast=(right_contrast, left_contrast),
+                    eye_sharpness=(right_sharpness, left_sharpness),
                 )
             )
         return faces

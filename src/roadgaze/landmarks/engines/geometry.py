@@ -213,7 +213,7 @@ def transformation_matrix(
     # Only the weighted landmarks enter the fits (the others have weight 0); the depth offset
     # is the mean over all of them.
     fit = face.fit
-    screen = mesh[fit.basis].T
+    screen = mesh.take(fit.basis, axis=0).T
     np.subtract(1.0, screen[1], out=screen[1])
     screen *= ((width_near,), (height_near,), (width_near,))
     screen -= ((0.5 * width_near,), (0.5 * height_near,), (0.0,))

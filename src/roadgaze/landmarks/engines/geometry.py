@@ -163,31 +163,43 @@ def _det3(matrix: npt.NDArray[np.float64]) -> float:
     return float(a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g))
 
 
-def _fit(
-    fit: _FitSource, target: npt.NDArray[np.float64]
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], float]:
-    """(u, vt, scale) of the weighted orthogonal Procrustes fit of the canonical face to
-    `target` (3, N over `fit.basis`), `FloatPrecisionProcrustesSolver`: the rotation is u @ vt
-    (reflection removed), the least-squares scale `scale`.
+def _cross(fit: _FitSource, target: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """The weighted cross-covariance (3x3) of `target` (3, N over `fit.basis`) and the
+    canonical face."""
+    cross: npt.NDArray[np.float64] = (target * fit.sqrt_weights).dot(fit.centered_t)
+    return cross
+
+
+def _scale(fit: _FitSource, singular: list[float], reflection: bool) -> float:
+    """The least-squares scale of a fit whose cross-covariance has these singular values.
 
     The solver's scale is sum((rotation @ centered) * weighted_target) / `fit.norm`, the trace
-    of rotation.T @ cross; with cross = u s vt and the reflection on the last axis, that trace
-    is s1 + s2 -+ s3, which needs no further matrix products.
+    of rotation.T @ cross; with cross = u s vt and rotation = u vt (the last axis of u negated
+    against a reflection), that trace is s1 + s2 + s3 (s1 + s2 - s3).
     """
-    u, singular, vt = np.linalg.svd((target * fit.sqrt_weights).dot(fit.centered_t))
-    s1, s2, s3 = singular.tolist()
-    if _det3(u) * _det3(vt) < 0:  # the best orthogonal map is a reflection: undo its last axis
-        u[:, 2] *= -1
-        s3 = -s3
-    return u, vt, (s1 + s2 + s3) / fit.norm
+    s1, s2, s3 = singular
+    return (s1 + s2 - s3 if reflection else s1 + s2 + s3) / fit.norm
+
+
+def _scale_of(fit: _FitSource, target: npt.NDArray[np.float64]) -> float:
+    """The scale of the weighted orthogonal Procrustes fit of the canonical face to `target`
+    (3, N over `fit.basis`), from the singular values alone (half the SVD's cost): det(cross)
+    has the sign of det(u) det(vt), singular values being >= 0 (where it is 0, so is s3)."""
+    cross = _cross(fit, target)
+    singular = np.linalg.svd(cross, compute_uv=False).tolist()
+    return _scale(fit, singular, _det3(cross) < 0)
 
 
 def _procrustes(fit: _FitSource, target: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """The 4x4 similarity (scale * rotation, translation) taking the canonical face closest to
-    `target` (3, N over `fit.basis`) in the weighted least-squares sense: the translation maps
-    the source's weighted mean onto the target's."""
-    u, vt, scale = _fit(fit, target)
-    rotation_scale = scale * u.dot(vt)
+    `target` (3, N over `fit.basis`) in the weighted least-squares sense
+    (`FloatPrecisionProcrustesSolver`: SVD of the cross-covariance, reflection removed,
+    least-squares scale); the translation maps the source's weighted mean onto the target's."""
+    u, singular, vt = np.linalg.svd(_cross(fit, target))
+    reflection = _det3(u) * _det3(vt) < 0
+    if reflection:
+        u[:, 2] *= -1
+    rotation_scale = _scale(fit, singular.tolist(), reflection) * u.dot(vt)
     matrix = np.empty((4, 4))
     matrix[:3, :3] = rotation_scale
     matrix[:3, 3] = target.dot(fit.mean_weights) - rotation_scale.dot(fit.center)
@@ -203,9 +215,13 @@ def transformation_matrix(
     gives none (landmarks collapsed to a point)."""
     mesh = np.asarray(landmarks[:MESH_LANDMARKS], np.float64)
     x, y, z = mesh.T
-    # Sums over 1-D columns: numpy reduces (N, 3) along axis 0 several times slower.
-    spread = np.hypot(x - x.sum() / len(mesh), y - y.sum() / len(mesh)).max()
-    if spread <= 1e-3:
+    # Sums over 1-D columns (numpy reduces (N, 3) along axis 0 several times slower); squared
+    # distances (np.hypot takes 30 ns a point).
+    dx, dy = x - x.sum() / len(mesh), y - y.sum() / len(mesh)
+    dx *= dx
+    dy *= dy
+    dx += dy
+    if math.sqrt(dx.max()) <= 1e-3:
         return None
     height_near = 2.0 * NEAR_PLANE * math.tan(0.5 * math.radians(VERTICAL_FOV_DEG))
     width_near = size[0] * height_near / size[1]
@@ -226,6 +242,6 @@ def transformation_matrix(
         np.negative(depth, out=points[2])
         return points
 
-    first = _fit(fit, screen * ((1.0,), (1.0,), (-1.0,)))[2]
-    second = _fit(fit, to_metric(first))[2]
+    first = _scale_of(fit, screen * ((1.0,), (1.0,), (-1.0,)))
+    second = _scale_of(fit, to_metric(first))
     return _procrustes(fit, to_metric(first * second))

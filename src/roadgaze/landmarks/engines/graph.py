@@ -125,8 +125,8 @@ def decode_detections(
     )
     keypoints = raw[:, 4:16].reshape(-1, 6, 2) + centers[:, None, :]
     valid = (boxes[:, 2] >= boxes[:, 0]) & (boxes[:, 3] >= boxes[:, 1])
-    order = [i for i in np.argsort(-scores[keep], kind="stable") if valid[i]]
-    return _weighted_nms(boxes, keypoints, scores[keep], order)
+    order = np.argsort(-scores[keep], kind="stable")
+    return _weighted_nms(boxes, keypoints, scores[keep], order[valid[order]])
 
 
 def _iou(box: FloatArray, boxes: FloatArray) -> FloatArray:
@@ -139,9 +139,9 @@ def _iou(box: FloatArray, boxes: FloatArray) -> FloatArray:
 
 
 def _weighted_nms(
-    boxes: FloatArray, keypoints: FloatArray, scores: FloatArray, order: list[int]
+    boxes: FloatArray, keypoints: FloatArray, scores: FloatArray, order: npt.NDArray[np.intp]
 ) -> list[FaceDetection]:
-    remaining = np.asarray(order, np.int64)
+    remaining = order
     found: list[FaceDetection] = []
     while remaining.size:
         top = int(remaining[0])

@@ -281,9 +281,11 @@ class OneEuroSmoother:
         self._derivative: npt.NDArray[np.float32] | None = None
 
     @staticmethod
-    def _alpha(cutoff: FloatArray | float, frequency: float) -> FloatArray:
-        tau = 1.0 / (2 * math.pi * np.asarray(cutoff, np.float64))
-        return np.asarray(1.0 / (1.0 + tau * frequency), np.float32)
+    def _alpha(cutoff: FloatArray | float, frequency: float) -> FloatArray | float:
+        """The smoothing factor, in doubles, for cutoffs (Hz) at `frequency` (Hz); MediaPipe
+        rounds it to a float. A number stays a number (as a 0-d array it cost 4 us)."""
+        tau = 1.0 / (2 * math.pi * cutoff)
+        return 1.0 / (1.0 + tau * frequency)
 
     def apply(self, t_us: int, pixels: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
         """The filtered pixels; the input unchanged for a face too small to scale (< 1e-6 px)."""
@@ -302,12 +304,10 @@ class OneEuroSmoother:
             self._derivative = np.zeros_like(values)
             return values
         speed = (values.astype(np.float64) - self._raw) * (1.0 / float(scale)) * frequency
-        alpha_d = self._alpha(ONE_EURO_DERIVATIVE_CUTOFF, frequency)
-        derivative = (
-            alpha_d * speed.astype(np.float32) + (1.0 - alpha_d) * self._derivative
-        ).astype(np.float32)
+        alpha_d = np.float32(self._alpha(ONE_EURO_DERIVATIVE_CUTOFF, frequency))
+        derivative = alpha_d * speed.astype(np.float32) + (1.0 - alpha_d) * self._derivative
         cutoff = ONE_EURO_MIN_CUTOFF + ONE_EURO_BETA * np.abs(derivative.astype(np.float64))
-        alpha = self._alpha(cutoff, frequency).astype(np.float64)
+        alpha = np.asarray(self._alpha(cutoff, frequency), np.float32).astype(np.float64)
         smoothed = (alpha * values + (1.0 - alpha) * self._value).astype(np.float32)
         self._raw, self._value, self._derivative = values, smoothed, derivative
         return smoothed

@@ -158,7 +158,7 @@ class CanonicalFace:
 
 def _det3(matrix: npt.NDArray[np.float64]) -> float:
     """The determinant of a 3x3 matrix in Python floats (a tenth of np.linalg.det's 7 us; the
-    fits only need the sign of the determinants of orthogonal matrices)."""
+    fits only read its sign)."""
     (a, b, c), (d, e, f), (g, h, i) = matrix.tolist()
     return float(a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g))
 

@@ -28,7 +28,12 @@ from roadgaze.config import Config, LandmarksConfig, load_config
 from roadgaze.errors import ModelError
 from roadgaze.landmarks import Landmarker, MediaPipeLandmarker
 from roadgaze.landmarks.engines import graph
-from roadgaze.landmarks.engines.geometry import CanonicalFace, transformation_matrix
+from roadgaze.landmarks.engines.geometry import (
+    CanonicalFace,
+    _procrustes,
+    _scale_of,
+    transformation_matrix,
+)
 from roadgaze.landmarks.features import angles_from_matrix_deg
 from roadgaze.landmarks.model_store import resolve_model
 from roadgaze.types import Detection
@@ -238,6 +243,31 @@ def test_matrix_recovers_the_pose_of_a_projected_canonical_face(
     found_yaw, found_pitch = angles_from_matrix_deg(matrix)
     assert found_yaw == pytest.approx(yaw_deg, abs=1.0)
     assert found_pitch == pytest.approx(pitch_deg, abs=1.0)
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_procrustes_recovers_a_similarity_and_its_scale_alone_agrees(
+    canonical_face: CanonicalFace, mirrored: bool
+) -> None:
+    """The weighted basis turned, scaled by 1.7 and moved: the fit gives the similarity back.
+    The scale-only fit (singular values and the sign of det(cross)) gives the full fit's scale
+    (u, vt and MediaPipe's reflection rule), also for a mirrored face, whose best orthogonal
+    map is a reflection the fit must refuse."""
+    fit = canonical_face.fit
+    rotation, _ = np.linalg.qr(np.random.default_rng(0).normal(size=(3, 3)))
+    rotation *= np.sign(np.linalg.det(rotation))
+    offset = np.array([[2.0], [-3.0], [-60.0]])
+    target = 1.7 * rotation @ canonical_face.points[:, fit.basis] + offset
+    if mirrored:
+        target[0] *= -1.0
+    matrix = _procrustes(fit, target)
+    scale = float(np.linalg.norm(matrix[:3, 0]))
+    assert _scale_of(fit, target) == pytest.approx(scale, rel=1e-12)
+    assert np.linalg.det(matrix[:3, :3]) > 0
+    if not mirrored:
+        np.testing.assert_allclose(matrix[:3, :3], 1.7 * rotation, atol=1e-9)
+        np.testing.assert_allclose(matrix[:3, 3], offset[:, 0], atol=1e-9)
+        np.testing.assert_allclose(matrix[3], [0, 0, 0, 1])
 
 
 # ---------------------------------------------------------------- bad input

@@ -21,7 +21,7 @@ reflection removed, least-squares scale; `procrustes_solver.cc`). Pure numpy, no
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -76,16 +76,56 @@ def _fields(data: bytes) -> list[tuple[int, int, bytes | int]]:
 
 
 @dataclass(frozen=True, slots=True)
+class _FitSource:
+    """The canonical face's side of the weighted Procrustes fits, computed once per bundle.
+
+    Only the weighted landmarks (33 of 468 in the bundle) enter a fit, and per frame only the
+    target changes. What remains per frame is a few numpy calls on (3, 33) arrays; at that size
+    a call's fixed cost (microseconds) is what a fit costs, not its arithmetic, so the fits
+    make as few calls as they can.
+    """
+
+    basis: npt.NDArray[np.intp]
+    """The weighted landmarks."""
+    sqrt_weights: npt.NDArray[np.float64]
+    center: npt.NDArray[np.float64]
+    """The weighted mean of the source points (3,)."""
+    centered_t: npt.NDArray[np.float64]
+    """sqrt(weight) * (source - center), transposed (N, 3): the cross-covariance's right side."""
+    norm: float
+    """sum(weight * (source - center) . source): the least-squares scale's denominator."""
+    mean_weights: npt.NDArray[np.float64]
+    """weight / sum(weight): `target @ mean_weights` is the target's weighted mean."""
+
+    @classmethod
+    def of(cls, points: npt.NDArray[np.float64], weights: npt.NDArray[np.float64]) -> _FitSource:
+        basis = np.flatnonzero(weights > 0)
+        source, used = points[:, basis], weights[basis]
+        sqrt_weights = np.sqrt(used)
+        weighted = source * sqrt_weights
+        total = float(used.sum())
+        center = (weighted * sqrt_weights).sum(axis=1) / total
+        centered = weighted - center[:, None] * sqrt_weights
+        return cls(
+            basis,
+            sqrt_weights,
+            center,
+            np.ascontiguousarray(centered.T),
+            float((centered * weighted).sum()),
+            used / total,
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class CanonicalFace:
     """The canonical face (3, 468) in centimetres and the Procrustes weight of each landmark."""
 
     points: npt.NDArray[np.float64]
     weights: npt.NDArray[np.float64]
+    fit: _FitSource = field(init=False, repr=False, compare=False)
 
-    @property
-    def basis(self) -> npt.NDArray[np.intp]:
-        """The landmarks with a weight (33 in the bundle): the fit reads only these."""
-        return np.flatnonzero(self.weights > 0)
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "fit", _FitSource.of(self.points, self.weights))
 
     @classmethod
     def from_metadata(cls, data: bytes) -> CanonicalFace:
@@ -116,28 +156,54 @@ class CanonicalFace:
         return cls(np.ascontiguousarray(mesh[:, :3].T), weights)
 
 
-def _procrustes(
-    source: npt.NDArray[np.float64],
-    target: npt.NDArray[np.float64],
-    weights: npt.NDArray[np.float64],
-) -> npt.NDArray[np.float64]:
-    """The 4x4 similarity (scale * rotation, translation) taking `source` (3, N) closest to
-    `target` in the weighted least-squares sense (`FloatPrecisionProcrustesSolver`)."""
-    sqrt_w = np.sqrt(weights)
-    ws, wt = source * sqrt_w, target * sqrt_w
-    total = float(weights.sum())
-    center = (ws * sqrt_w).sum(axis=1) / total
-    centered = ws - center[:, None] * sqrt_w
-    u, _, vt = np.linalg.svd(wt @ centered.T)
-    if np.linalg.det(u) * np.linalg.det(vt) < 0:
+def _det3(matrix: npt.NDArray[np.float64]) -> float:
+    """The determinant of a 3x3 matrix in Python floats (a tenth of np.linalg.det's 7 us; the
+    fits only read its sign)."""
+    (a, b, c), (d, e, f), (g, h, i) = matrix.tolist()
+    return float(a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g))
+
+
+def _cross(fit: _FitSource, target: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """The weighted cross-covariance (3x3) of `target` (3, N over `fit.basis`) and the
+    canonical face."""
+    cross: npt.NDArray[np.float64] = (target * fit.sqrt_weights).dot(fit.centered_t)
+    return cross
+
+
+def _scale(fit: _FitSource, singular: list[float], reflection: bool) -> float:
+    """The least-squares scale of a fit whose cross-covariance has these singular values.
+
+    The solver's scale is sum((rotation @ centered) * weighted_target) / `fit.norm`, the trace
+    of rotation.T @ cross; with cross = u s vt and rotation = u vt (the last axis of u negated
+    against a reflection), that trace is s1 + s2 + s3 (s1 + s2 - s3).
+    """
+    s1, s2, s3 = singular
+    return (s1 + s2 - s3 if reflection else s1 + s2 + s3) / fit.norm
+
+
+def _scale_of(fit: _FitSource, target: npt.NDArray[np.float64]) -> float:
+    """The scale of the weighted orthogonal Procrustes fit of the canonical face to `target`
+    (3, N over `fit.basis`), from the singular values alone (half the SVD's cost): det(cross)
+    has the sign of det(u) det(vt), singular values being >= 0 (where it is 0, so is s3)."""
+    cross = _cross(fit, target)
+    singular = np.linalg.svd(cross, compute_uv=False).tolist()
+    return _scale(fit, singular, _det3(cross) < 0)
+
+
+def _procrustes(fit: _FitSource, target: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """The 4x4 similarity (scale * rotation, translation) taking the canonical face closest to
+    `target` (3, N over `fit.basis`) in the weighted least-squares sense
+    (`FloatPrecisionProcrustesSolver`: SVD of the cross-covariance, reflection removed,
+    least-squares scale); the translation maps the source's weighted mean onto the target's."""
+    u, singular, vt = np.linalg.svd(_cross(fit, target))
+    reflection = _det3(u) * _det3(vt) < 0
+    if reflection:
         u[:, 2] *= -1
-    rotation = u @ vt
-    scale = float(((rotation @ centered) * wt).sum() / (centered * ws).sum())
-    rotation_scale = scale * rotation
-    translation = ((wt - rotation_scale @ ws) * sqrt_w).sum(axis=1) / total
-    matrix = np.eye(4)
+    rotation_scale = _scale(fit, singular.tolist(), reflection) * u.dot(vt)
+    matrix = np.empty((4, 4))
     matrix[:3, :3] = rotation_scale
-    matrix[:3, 3] = translation
+    matrix[:3, 3] = target.dot(fit.mean_weights) - rotation_scale.dot(fit.center)
+    matrix[3] = (0.0, 0.0, 0.0, 1.0)
     return matrix
 
 
@@ -148,34 +214,34 @@ def transformation_matrix(
     (the first 468 are used) in an image of `size` (width, height) pixels; None where MediaPipe
     gives none (landmarks collapsed to a point)."""
     mesh = np.asarray(landmarks[:MESH_LANDMARKS], np.float64)
-    spread = np.hypot(mesh[:, 0] - mesh[:, 0].mean(), mesh[:, 1] - mesh[:, 1].mean()).max()
-    if spread <= 1e-3:
+    x, y, z = mesh.T
+    # Sums over 1-D columns (numpy reduces (N, 3) along axis 0 several times slower); squared
+    # distances (np.hypot takes 30 ns a point).
+    dx, dy = x - x.sum() / len(mesh), y - y.sum() / len(mesh)
+    dx *= dx
+    dy *= dy
+    dx += dy
+    if math.sqrt(dx.max()) <= 1e-3:
         return None
     height_near = 2.0 * NEAR_PLANE * math.tan(0.5 * math.radians(VERTICAL_FOV_DEG))
     width_near = size[0] * height_near / size[1]
-    depth_offset = float(mesh[:, 2].mean()) * width_near
+    depth_offset = float(z.sum()) / len(mesh) * width_near
     # Only the weighted landmarks enter the fits (the others have weight 0); the depth offset
     # is the mean over all of them.
-    basis = face.basis
-    source, weights = face.points[:, basis], face.weights[basis]
-    screen = mesh[basis].T.copy()
-    screen[1] = 1.0 - screen[1]
-    screen *= np.array([[width_near], [height_near], [width_near]])
-    screen[0] -= 0.5 * width_near
-    screen[1] -= 0.5 * height_near
-
-    def scale_of(points: npt.NDArray[np.float64]) -> float:
-        return float(np.linalg.norm(_procrustes(source, points, weights)[:3, 0]))
+    fit = face.fit
+    screen = mesh.take(fit.basis, axis=0).T
+    np.subtract(1.0, screen[1], out=screen[1])
+    screen *= ((width_near,), (height_near,), (width_near,))
+    screen -= ((0.5 * width_near,), (0.5 * height_near,), (0.0,))
+    depth_base = screen[2] - depth_offset + NEAR_PLANE
 
     def to_metric(scale: float) -> npt.NDArray[np.float64]:
-        points = screen.copy()
-        points[2] = (points[2] - depth_offset + NEAR_PLANE) / scale
-        points[:2] *= points[2] / NEAR_PLANE
-        points[2] *= -1.0
+        depth = depth_base / scale
+        points = np.empty_like(screen)
+        np.multiply(screen[:2], depth / NEAR_PLANE, out=points[:2])
+        np.negative(depth, out=points[2])
         return points
 
-    flipped = screen.copy()
-    flipped[2] *= -1.0
-    first = scale_of(flipped)
-    second = scale_of(to_metric(first))
-    return _procrustes(source, to_metric(first * second), weights)
+    first = _scale_of(fit, screen * ((1.0,), (1.0,), (-1.0,)))
+    second = _scale_of(fit, to_metric(first))
+    return _procrustes(fit, to_metric(first * second))

@@ -125,8 +125,8 @@ def decode_detections(
     )
     keypoints = raw[:, 4:16].reshape(-1, 6, 2) + centers[:, None, :]
     valid = (boxes[:, 2] >= boxes[:, 0]) & (boxes[:, 3] >= boxes[:, 1])
-    order = [i for i in np.argsort(-scores[keep], kind="stable") if valid[i]]
-    return _weighted_nms(boxes, keypoints, scores[keep], order)
+    order = np.argsort(-scores[keep], kind="stable")
+    return _weighted_nms(boxes, keypoints, scores[keep], order[valid[order]])
 
 
 def _iou(box: FloatArray, boxes: FloatArray) -> FloatArray:
@@ -139,9 +139,9 @@ def _iou(box: FloatArray, boxes: FloatArray) -> FloatArray:
 
 
 def _weighted_nms(
-    boxes: FloatArray, keypoints: FloatArray, scores: FloatArray, order: list[int]
+    boxes: FloatArray, keypoints: FloatArray, scores: FloatArray, order: npt.NDArray[np.intp]
 ) -> list[FaceDetection]:
-    remaining = np.asarray(order, np.int64)
+    remaining = order
     found: list[FaceDetection] = []
     while remaining.size:
         top = int(remaining[0])
@@ -178,10 +178,13 @@ def project_detection(
     return FaceDetection((low[0], low[1], high[0], high[1]), points, detection.score)
 
 
-def rotation_of(points: FloatArray, start: int, end: int, size: tuple[int, int]) -> float:
-    """Rotation that makes the line `start` -> `end` horizontal (`DetectionsToRects`), radians."""
-    x0, y0 = points[start, 0] * size[0], points[start, 1] * size[1]
-    x1, y1 = points[end, 0] * size[0], points[end, 1] * size[1]
+def rotation_of(
+    points: npt.NDArray[np.floating], start: int, end: int, size: tuple[int, int]
+) -> float:
+    """Rotation that makes the line `start` -> `end` horizontal (`DetectionsToRects`), radians;
+    in doubles whatever the points' type."""
+    (x0, y0), (x1, y1) = points[start, :2].tolist(), points[end, :2].tolist()
+    x0, y0, x1, y1 = x0 * size[0], y0 * size[1], x1 * size[0], y1 * size[1]
     return normalize_radians(-math.atan2(-(y1 - y0), x1 - x0))
 
 
@@ -203,11 +206,13 @@ def detection_rect(detection: FaceDetection, size: tuple[int, int]) -> Rect:
 def landmarks_rect(landmarks: npt.NDArray[np.floating], size: tuple[int, int]) -> Rect:
     """The next frame's region for a face with these normalised landmarks (`LandmarksToDetection`,
     `DetectionsToRects` with 33 -> 263, `RectTransformation` square long side, scale 1.5)."""
-    xy = landmarks[:, :2].astype(np.float64)
-    x_min, y_min = xy.min(axis=0)
-    x_max, y_max = max(float(xy[:, 0].max()), FLOAT_MIN), max(float(xy[:, 1].max()), FLOAT_MIN)
+    # Extremes of 1-D columns (numpy reduces (N, 2) along axis 0 several times slower); exact
+    # in any float type, so taken before the conversion to Python floats.
+    x, y = landmarks[:, 0], landmarks[:, 1]
+    x_min, y_min = float(x.min()), float(y.min())
+    x_max, y_max = max(float(x.max()), FLOAT_MIN), max(float(y.max()), FLOAT_MIN)
     width, height = x_max - x_min, y_max - y_min
-    rotation = rotation_of(xy, *ROI_EYES, size)
+    rotation = rotation_of(landmarks, *ROI_EYES, size)
     long_side_px = max(width * size[0], height * size[1])
     return Rect(
         x_min + width / 2,
@@ -276,9 +281,11 @@ class OneEuroSmoother:
         self._derivative: npt.NDArray[np.float32] | None = None
 
     @staticmethod
-    def _alpha(cutoff: FloatArray | float, frequency: float) -> FloatArray:
-        tau = 1.0 / (2 * math.pi * np.asarray(cutoff, np.float64))
-        return np.asarray(1.0 / (1.0 + tau * frequency), np.float32)
+    def _alpha(cutoff: FloatArray | float, frequency: float) -> FloatArray | float:
+        """The smoothing factor, in doubles, for cutoffs (Hz) at `frequency` (Hz); MediaPipe
+        rounds it to a float. A number stays a number (as a 0-d array it cost 4 us)."""
+        tau = 1.0 / (2 * math.pi * cutoff)
+        return 1.0 / (1.0 + tau * frequency)
 
     def apply(self, t_us: int, pixels: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
         """The filtered pixels; the input unchanged for a face too small to scale (< 1e-6 px)."""
@@ -297,12 +304,10 @@ class OneEuroSmoother:
             self._derivative = np.zeros_like(values)
             return values
         speed = (values.astype(np.float64) - self._raw) * (1.0 / float(scale)) * frequency
-        alpha_d = self._alpha(ONE_EURO_DERIVATIVE_CUTOFF, frequency)
-        derivative = (
-            alpha_d * speed.astype(np.float32) + (1.0 - alpha_d) * self._derivative
-        ).astype(np.float32)
+        alpha_d = np.float32(self._alpha(ONE_EURO_DERIVATIVE_CUTOFF, frequency))
+        derivative = alpha_d * speed.astype(np.float32) + (1.0 - alpha_d) * self._derivative
         cutoff = ONE_EURO_MIN_CUTOFF + ONE_EURO_BETA * np.abs(derivative.astype(np.float64))
-        alpha = self._alpha(cutoff, frequency).astype(np.float64)
+        alpha = np.asarray(self._alpha(cutoff, frequency), np.float32).astype(np.float64)
         smoothed = (alpha * values + (1.0 - alpha) * self._value).astype(np.float32)
         self._raw, self._value, self._derivative = values, smoothed, derivative
         return smoothed

@@ -132,10 +132,14 @@ class _Model:
         self._outputs = [d["index"] for d in self._interpreter.get_output_details()]
 
     def run(
-        self, values: npt.NDArray[Any], scale: float = 1.0, offset: float = 0.0
+        self,
+        values: npt.NDArray[Any],
+        scale: float | npt.NDArray[np.float32] = 1.0,
+        offset: float = 0.0,
     ) -> list[npt.NDArray[np.float32]]:
         """The outputs (copies, model order) for the input `values * scale + offset` of
-        `input_shape` without the batch, written straight into the interpreter's input."""
+        `input_shape` without the batch, written straight into the interpreter's input;
+        `scale` is a number or float32 factors broadcast over `values`' last axis."""
         view = self._input()[0]
         np.multiply(values, np.float32(scale), out=view, casting="unsafe")
         if offset:
@@ -305,7 +309,7 @@ class LiteRtFaceLandmarker:
             if faces and timestamp_ms is not None:
                 scale = np.array([size[0], size[1], size[0]], np.float32)
                 smoothed = self._smoother.apply(timestamp_ms * 1000, faces[0] * scale)
-                faces[0] = (smoothed / scale).astype(np.float32)
+                faces[0] = smoothed / scale  # float32 / float32: already MediaPipe's floats
             else:
                 self._smoother.reset()
         return [
@@ -318,9 +322,12 @@ class LiteRtFaceLandmarker:
         return transformation_matrix(points, size, self._face)
 
     def _scores(self, points: npt.NDArray[np.float32], size: tuple[int, int]) -> dict[str, float]:
-        subset = points[BLENDSHAPE_INDEX, :2] * np.array(size, np.float32)
-        scores = self._blendshapes.run(subset.astype(np.float32))[0].reshape(-1)
-        return {name: float(score) for name, score in zip(BLENDSHAPE_NAMES, scores, strict=True)}
+        """The blendshapes of one face: its model's landmarks in pixels (float32 products),
+        multiplied straight into the model's input (`take` picks the rows in a third of the
+        time of fancy indexing)."""
+        subset = points.take(BLENDSHAPE_INDEX, axis=0)[:, :2]
+        scores = self._blendshapes.run(subset, np.array(size, np.float32))[0]
+        return dict(zip(BLENDSHAPE_NAMES, scores.reshape(-1).tolist(), strict=True))
 
     def close(self) -> None:
         self._tracked = []

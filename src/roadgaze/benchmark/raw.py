@@ -10,8 +10,9 @@ public Python API (its conversion of the result to Python objects included).
 
 from __future__ import annotations
 
+import logging
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from itertools import islice
 from pathlib import Path
@@ -19,8 +20,10 @@ from typing import Any
 
 import numpy as np
 
-from roadgaze.config import LandmarksConfig
+from roadgaze.config import Config, LandmarksConfig
 from roadgaze.types import Frame
+
+log = logging.getLogger(__name__)
 
 CHUNK_FRAMES = 64
 """Frames decoded and converted before a run of timed calls (about 60 MB at 640x480)."""
@@ -122,7 +125,25 @@ def raw_mediapipe_pass(
     return RawResult(tuple(durations_s), cpu_s, (fps,))
 
 
-def litert_models_pass(
+def litert_models_pass(spec: str, config: Config, warmup: int) -> Callable[[], RawResult] | None:
+    """A pass of `models_alone` over the source `spec` (None without ai-edge-litert)."""
+    import importlib.util
+
+    if importlib.util.find_spec("ai_edge_litert") is None:
+        return None
+
+    def run() -> RawResult:
+        from roadgaze.capture import open_source
+        from roadgaze.landmarks.model_store import resolve_model
+
+        log.info("models-alone pass (LiteRT)")
+        with open_source(spec, config) as source:
+            return models_alone(source, resolve_model(config.model), config.landmarks, warmup)
+
+    return run
+
+
+def models_alone(
     frames: Iterable[Frame], model_path: Path, config: LandmarksConfig, warmup: int
 ) -> RawResult:
     """Time the bundle's landmark and blendshape models alone on LiteRT, once each per frame of

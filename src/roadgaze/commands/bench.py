@@ -104,6 +104,13 @@ def open_bench_source(args: argparse.Namespace, config: Config) -> FrameSource:
     return LoopingSource(lambda: VideoFileSource(path), duration_s=args.loop_seconds)
 
 
+def models_pass(args: argparse.Namespace, config: Config) -> Callable[[], RawResult] | None:
+    """A pass of the bundle's models alone on LiteRT (None without ai-edge-litert)."""
+    from roadgaze.benchmark.raw import litert_models_pass
+
+    return litert_models_pass(args.source, config, args.warmup)
+
+
 def raw_pass(args: argparse.Namespace, config: Config, number: int, count: int) -> RawResult:
     """One raw-MediaPipe pass over the source's frames (one pass of a looped file)."""
     from roadgaze.benchmark import raw_mediapipe_pass
@@ -113,26 +120,6 @@ def raw_pass(args: argparse.Namespace, config: Config, number: int, count: int) 
     log.info("raw MediaPipe pass %d of %d", number, count)
     with open_source(args.source, config) as source:
         return raw_mediapipe_pass(
-            source, resolve_model(config.model), config.landmarks, args.warmup
-        )
-
-
-def litert_available() -> bool:
-    """Whether ai-edge-litert is installed (`bench --engines` then times the models alone)."""
-    import importlib.util
-
-    return importlib.util.find_spec("ai_edge_litert") is not None
-
-
-def models_pass(args: argparse.Namespace, config: Config) -> RawResult:
-    """One pass of the bundle's models alone on LiteRT over the source's frames."""
-    from roadgaze.benchmark.raw import litert_models_pass
-    from roadgaze.capture import open_source
-    from roadgaze.landmarks.model_store import resolve_model
-
-    log.info("models-alone pass (LiteRT)")
-    with open_source(args.source, config) as source:
-        return litert_models_pass(
             source, resolve_model(config.model), config.landmarks, args.warmup
         )
 
@@ -231,7 +218,7 @@ def engines_run(args: argparse.Namespace, config: Config) -> int:
         args.repeat,
         engine_pass,
         lambda: raw_pass(args, config, next(raws), args.repeat + 1),
-        (lambda: models_pass(args, config)) if litert_available() else None,
+        models_pass(args, config),
     )
     result = {"source": args.source, "default_engine": config.landmarks.engine, **result}
     print(json.dumps(result) if args.json else "\n".join(format_engines(result)))

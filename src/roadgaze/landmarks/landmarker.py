@@ -12,7 +12,9 @@ no state). `detect` is the three in a row.
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -22,7 +24,7 @@ import numpy.typing as npt
 
 from roadgaze.config import Config, LandmarksConfig
 from roadgaze.landmarks.driver import choose_driver, merge_mirrored
-from roadgaze.landmarks.engines import FaceCounting, FaceRunner, open_engine
+from roadgaze.landmarks.engines import FaceCounting, FaceRunner, Tracking, open_engine
 from roadgaze.landmarks.eye_contrast import eye_checks
 from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
 from roadgaze.landmarks.features import (
@@ -34,7 +36,7 @@ from roadgaze.landmarks.features import (
 )
 from roadgaze.landmarks.multi_face import BackgroundCount, FaceMode, MultiFaceSwitch
 from roadgaze.landmarks.native_log import filtered_native_stderr
-from roadgaze.landmarks.results import Blendshapes
+from roadgaze.landmarks.results import Blendshapes, FaceArrays
 from roadgaze.types import ClosesOnExit, Detection, FaceFeatures
 
 
@@ -92,6 +94,13 @@ class FoundFace:
     blendshapes: Blendshapes | None
     box_px: Box
     """(x_min, y_min, x_max, y_max) of the landmarks, pixels (what `FaceFeatures.box_px` holds)."""
+    pending: Callable[[], tuple[npt.NDArray[np.float64] | None, Blendshapes | None]] | None = None
+    """An engine that tracks faces apart (`Tracking`): the matrix and the blendshapes, computed
+    when the face is measured (`matrix` and `blendshapes` are None until then)."""
+
+    def outputs(self) -> tuple[npt.NDArray[np.float64] | None, Blendshapes | None]:
+        """The matrix and the blendshapes (computed now for a pending face)."""
+        return (self.matrix, self.blendshapes) if self.pending is None else self.pending()
 
 
 @dataclass(frozen=True, slots=True)
@@ -319,15 +328,25 @@ class Landmarker(ClosesOnExit):
         if landmarker is None:
             raise ValueError("landmarker is closed")
         scale = np.array([size[0], size[1], size[0]], np.float32)
-        results = landmarker.run(mp_image, timestamp_ms)
+        tracking = landmarker if isinstance(landmarker, Tracking) else None
+        if tracking is not None:
+            # The rest of each face is left to `measure` (the loop's other thread).
+            tracked = tracking.track(mp_image, timestamp_ms)
+            results: list[FaceArrays] = [(points, None, None) for points in tracked]
+        else:
+            results = landmarker.run(mp_image, timestamp_ms)
         faces: list[FoundFace] = []
         for points, matrix, blendshapes in results:
             pixels = points * scale
             if pixels.shape != (NUM_LANDMARKS, 3):
                 continue
             box = finite_box_px(pixels)
-            if box is not None:
-                faces.append(FoundFace(pixels, matrix, blendshapes, box))
+            if box is None:
+                continue
+            pending = None
+            if tracking is not None:
+                pending = functools.partial(tracking.complete, points, size)
+            faces.append(FoundFace(pixels, matrix, blendshapes, box, pending))
         return faces
 
     def _features(
@@ -341,13 +360,14 @@ class Landmarker(ClosesOnExit):
             pixels = face.landmarks_px
             right_contrast, right_sharpness = eye_checks(gray, pixels, RIGHT_EYE)
             left_contrast, left_sharpness = eye_checks(gray, pixels, LEFT_EYE)
+            matrix, blendshapes = face.outputs()
             faces.append(
                 features_from_landmarks(
                     pixels,
                     size,
-                    face.matrix,
+                    matrix,
                     self._choice,
-                    blendshapes=face.blendshapes,
+                    blendshapes=blendshapes,
                     eye_contrast=(right_contrast, left_contrast),
                     eye_sharpness=(right_sharpness, left_sharpness),
                 )

@@ -15,16 +15,19 @@ from __future__ import annotations
 
 import logging
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+import numpy.typing as npt
 
 from roadgaze.config import LandmarksConfig
 from roadgaze.errors import ModelError
 from roadgaze.landmarks.multi_face import FaceCounting
-from roadgaze.landmarks.results import FaceArrays
+from roadgaze.landmarks.results import Blendshapes, FaceArrays
 
 log = logging.getLogger(__name__)
 
-__all__ = ["ENGINES", "Engine", "FaceCounting", "FaceRunner", "open_engine"]
+__all__ = ["ENGINES", "Engine", "FaceCounting", "FaceRunner", "Tracking", "open_engine"]
 
 ENGINES = ("litert", "mediapipe")
 LITERT_FIX = "pip install 'ai-edge-litert==2.3.0'"
@@ -36,6 +39,20 @@ class FaceRunner(Protocol):
     def run(self, image: Any, timestamp_ms: int | None) -> list[FaceArrays]: ...
 
     def close(self) -> None: ...
+
+
+@runtime_checkable
+class Tracking(Protocol):
+    """A `FaceRunner` whose run splits in two: `track` (the landmarks, which the next frame's
+    regions depend on) and `complete` (the matrix and the blendshapes of one face, which nothing
+    later needs). The loop measures faces on another thread than it infers them, so `complete`
+    runs there, in parallel with `track` on the next frame (the LiteRT engine)."""
+
+    def track(self, image: Any, timestamp_ms: int | None) -> list[npt.NDArray[np.float32]]: ...
+
+    def complete(
+        self, points: npt.NDArray[np.float32], size: tuple[int, int]
+    ) -> tuple[npt.NDArray[np.float64] | None, Blendshapes | None]: ...
 
 
 class Engine(Protocol):

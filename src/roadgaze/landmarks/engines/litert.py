@@ -287,6 +287,14 @@ class LiteRtFaceLandmarker:
     def run(self, rgb: npt.NDArray[np.uint8], timestamp_ms: int | None) -> list[FaceArrays]:
         """Faces in the RGB image: normalised landmarks, the matrix and the blendshapes each."""
         size = (rgb.shape[1], rgb.shape[0])
+        return [(points, *self.complete(points, size)) for points in self.track(rgb, timestamp_ms)]
+
+    def track(
+        self, rgb: npt.NDArray[np.uint8], timestamp_ms: int | None
+    ) -> list[npt.NDArray[np.float32]]:
+        """The normalised landmarks of the faces in the RGB image: the part of `run` the next
+        frame depends on (regions, tracking, smoothing); `complete` gives the rest."""
+        size = (rgb.shape[1], rgb.shape[0])
         rects = self._tracked if self._video else []
         if len(rects) < self._num_faces:
             found = self._detector.detect(rgb)[: self._num_faces]
@@ -312,14 +320,16 @@ class LiteRtFaceLandmarker:
                 faces[0] = smoothed / scale  # float32 / float32: already MediaPipe's floats
             else:
                 self._smoother.reset()
-        return [
-            (points, self._matrix(points, size), self._scores(points, size)) for points in faces
-        ]
+        return faces
 
-    def _matrix(
+    def complete(
         self, points: npt.NDArray[np.float32], size: tuple[int, int]
-    ) -> npt.NDArray[np.float64] | None:
-        return transformation_matrix(points, size, self._face)
+    ) -> tuple[npt.NDArray[np.float64] | None, dict[str, float]]:
+        """The transformation matrix and the blendshapes of one face `track` found in an image
+        of `size` (width, height). Nothing later depends on them, so the loop computes them on
+        the thread that measures the face, while `track` works on the next frame (only that
+        thread uses the blendshape model)."""
+        return transformation_matrix(points, size, self._face), self._scores(points, size)
 
     def _scores(self, points: npt.NDArray[np.float32], size: tuple[int, int]) -> dict[str, float]:
         """The blendshapes of one face: its model's landmarks in pixels (float32 products),

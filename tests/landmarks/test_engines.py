@@ -307,3 +307,28 @@ def test_a_delegate_that_does_not_load_runs_mediapipe_with_a_warning(
     with Landmarker(config, model_path, engine="litert") as detector:
         assert detector.engine == "mediapipe"
     assert "libnpu_delegate.so" in caplog.text and "running MediaPipe instead" in caplog.text
+
+
+def test_faces_completed_when_measured_equal_a_whole_run(model_path: Path) -> None:
+    """The loop measures a LiteRT face (matrix, blendshapes) after tracking it, on its own
+    thread: the same numbers as the runner's whole `run` on the same frames."""
+    from roadgaze.landmarks.engines.litert import Bundle, LiteRtFaceLandmarker
+
+    config = LandmarksConfig(multi_face_check_s=0.0, max_faces=1)
+    frames = gif_frames("head-pose-face-detection-male.gif", 12)
+    runner = LiteRtFaceLandmarker(Bundle.read(model_path), config, 1, video=True)
+    with Landmarker(config, model_path, video=True, engine="litert") as landmarker:
+        for index, frame in enumerate(frames):
+            t_s = index / 15.0
+            prepared = landmarker.prepare(frame)
+            inference = landmarker.infer(prepared, t_s)
+            assert all(face.pending is not None for face in inference.faces)
+            measured = landmarker.measure(inference).faces
+            whole = runner.run(prepared.rgb, max(round(t_s * 1000.0), index))
+            assert len(measured) == len(whole) == 1
+            _, matrix, blendshapes = whole[0]
+            assert measured[0].blendshapes == blendshapes
+            assert matrix is not None
+            yaw_deg, pitch_deg = angles_from_matrix_deg(matrix)
+            assert measured[0].mediapipe_yaw_deg == yaw_deg
+            assert measured[0].mediapipe_pitch_deg == pitch_deg

@@ -104,7 +104,7 @@ class LandmarksConfig(_Section):
     mirror_average: bool = False
     """Also run the mirrored image and average the two measurements: exactly mirror-symmetric
     yaw and slightly better accuracy (docs/landmarks.md) for twice the landmarker time."""
-    engine: Literal["litert", "mediapipe"] = "mediapipe"
+    engine: Literal["litert", "mediapipe"] = "litert"
     """What runs the face landmarker's models: `litert` (the three models on LiteRT with
     MediaPipe's graph rebuilt around them, roadgaze.landmarks.engines) or `mediapipe` (its
     FaceLandmarker, the reference). See docs/landmarks.md."""

@@ -158,10 +158,11 @@ def test_bench_latency_through_a_loopback_subscriber(capsys: pytest.CaptureFixtu
     # The two parts: in the loop up to the publish (at least the landmark stage), then Zenoh.
     # The publish is stamped when the put has returned; on a loaded machine the subscriber in the
     # other process can log the arrival first (the loop's thread descheduled between the two), so
-    # the delivery part may read a fraction of a millisecond below zero, never more.
+    # the delivery part may read a fraction of a millisecond below zero, never more; so may the
+    # whole against its first part (medians of frames whose delivery reads below zero).
     assert -1.0 < latency["delivery_p50_ms"] < latency["p50_ms"]
     assert latency["to_publish_p50_ms"] >= latency["landmarks_p50_ms"]
-    assert latency["to_publish_p50_ms"] <= latency["p50_ms"]
+    assert latency["to_publish_p50_ms"] < latency["p50_ms"] + 1.0
 
 
 @pytest.mark.parametrize(

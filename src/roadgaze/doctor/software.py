@@ -26,6 +26,7 @@ from roadgaze.doctor.report import Check, Status
 
 KEY_PACKAGES = (
     "mediapipe",
+    "ai-edge-litert",
     "eclipse-zenoh",
     "numpy",
     "filterpy",
@@ -34,8 +35,14 @@ KEY_PACKAGES = (
     "tqdm",
     "scikit-image",
 )
-"""roadgaze's dependencies besides OpenCV (which has its own check)."""
-IMPORTS = {"mediapipe": "mediapipe", "zenoh": "eclipse-zenoh", "cv2": "opencv-contrib-python"}
+"""roadgaze's dependencies besides OpenCV (which has its own check); ai-edge-litert runs the
+default landmark engine (without it the MediaPipe engine runs, with a warning)."""
+IMPORTS = {
+    "mediapipe": "mediapipe",
+    "ai_edge_litert.interpreter": "ai-edge-litert",
+    "zenoh": "eclipse-zenoh",
+    "cv2": "opencv-contrib-python",
+}
 """Modules whose import is tried, with the distribution that provides them."""
 OPENCV_DISTRIBUTIONS = (
     "opencv-contrib-python",

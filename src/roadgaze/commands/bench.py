@@ -104,13 +104,6 @@ def open_bench_source(args: argparse.Namespace, config: Config) -> FrameSource:
     return LoopingSource(lambda: VideoFileSource(path), duration_s=args.loop_seconds)
 
 
-def models_pass(args: argparse.Namespace, config: Config) -> Callable[[], RawResult] | None:
-    """A pass of the bundle's models alone on LiteRT (None without ai-edge-litert)."""
-    from roadgaze.benchmark.raw import litert_models_pass
-
-    return litert_models_pass(args.source, config, args.warmup)
-
-
 def raw_pass(args: argparse.Namespace, config: Config, number: int, count: int) -> RawResult:
     """One raw-MediaPipe pass over the source's frames (one pass of a looped file)."""
     from roadgaze.benchmark import raw_mediapipe_pass
@@ -202,6 +195,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
 def engines_run(args: argparse.Namespace, config: Config) -> int:
     """`--engines`: both engines and raw FaceLandmarker, interleaved (`benchmark.engines`)."""
     from roadgaze.benchmark.engines import EnginePass, compare_engines, format_engines
+    from roadgaze.benchmark.raw import litert_models_pass
     from roadgaze.pipeline import StageTimings
 
     def engine_pass(name: str) -> EnginePass:
@@ -218,7 +212,7 @@ def engines_run(args: argparse.Namespace, config: Config) -> int:
         args.repeat,
         engine_pass,
         lambda: raw_pass(args, config, next(raws), args.repeat + 1),
-        models_pass(args, config),
+        litert_models_pass(args.source, config, args.warmup),
     )
     result = {"source": args.source, "default_engine": config.landmarks.engine, **result}
     print(json.dumps(result) if args.json else "\n".join(format_engines(result)))

@@ -183,10 +183,11 @@ class Warper:
         in floats, which moved the detector's keypoints by up to 0.4 px. So the source positions
         are computed here (a rectangle onto a square: an affine map), `convertMaps` rounds them
         to 1/32 pixel as the classic code does, and `remap` interpolates them with the
-        fixed-point tables. The positions are float32 (a third of the memory traffic of
-        doubles, 0.2 ms less a frame): where the classic double lies within float32's rounding
-        (6e-5 px at 640 px) of a 1/64 px tie, a pixel is sampled 1/32 px apart, about 35 of
-        65,536 pixels of a 256 px crop, moving the landmarks by about 0.01 px.
+        fixed-point tables. The positions are float32 (less memory traffic than doubles and
+        no rounding pass in numpy: 1.30 -> 0.78 ms of CPU per 256 px crop): where the classic
+        double lies within float32's rounding (6e-5 px at 640 px) of a 1/64 px tie, a pixel is
+        sampled 1/32 px apart, about 35 of 65,536 pixels of a 256 px crop, moving the
+        landmarks by about 0.01 px.
         """
         import cv2
 

@@ -105,7 +105,7 @@ def test_the_gates_name_what_holds_the_score_and_can_be_taken_as_met() -> None:
         "mandatory noise variables not shown functional: Daytime - Night-time, Clear "
         "sunglasses, Short facial hair, Long facial hair, Face-mask"
     )
-    assert gates[1].startswith("8 general requirements not met: Speed activation condition")
+    assert gates[1].startswith("8 general requirements not met: speed activation of distraction")
     opened = with_gates_met(dossier)
     assert opened.gates() == [] and opened.cells == dossier.cells
     cap = opened.noise_of("Cap")

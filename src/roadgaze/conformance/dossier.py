@@ -91,13 +91,12 @@ class Dossier:
     def gates(self) -> list[str]:
         """What holds the calculator's Driver Monitoring score at 0 whatever the rows earn."""
         held = [n.variable.element for n in self.noise if n.variable.mandatory and not n.functional]
-        failed = [g.requirement.text for g in self.general if g.value == "FAIL"]
+        failed = [g.requirement.label for g in self.general if g.value == "FAIL"]
         gates = []
         if held:
             gates.append(f"mandatory noise variables not shown functional: {', '.join(held)}")
         if failed:
-            shown = "; ".join(text if len(text) <= 60 else f"{text[:57]}..." for text in failed)
-            gates.append(f"{len(failed)} general requirements not met: {shown}")
+            gates.append(f"{len(failed)} general requirements not met: {'; '.join(failed)}")
         return gates
 
 

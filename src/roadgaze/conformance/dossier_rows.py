@@ -195,6 +195,8 @@ class GeneralRequirement:
     the dossier states Functional; otherwise FAIL, `missing` saying what is not there."""
 
     text: str
+    label: str
+    """A few words for the score's summary."""
     evidence: tuple[str, ...] = ()
     basis: str = ""
     integrator: str = ""
@@ -207,63 +209,85 @@ _NO_NOTICE = "no non-functional notice yet (its rule and scenario are still to c
 GENERAL_REQUIREMENTS: tuple[GeneralRequirement, ...] = (
     GeneralRequirement(
         "Default ON at the start of every journey",
+        "on by default",
         ("lap_70.warns",),
         basis="the service monitors from its first frame; no setting turns monitoring off",
     ),
     GeneralRequirement(
         "Deactivation is not possible with a momentary single push on a button",
+        "no off by a single push",
         integrator="the service has no off switch; the vehicle's buttons are the integrator's",
     ),
     GeneralRequirement(
         "Detection sensitivity shall not be manually adjustable",
+        "sensitivity not adjustable",
         integrator="the service takes no driver input; its settings are the integrator's",
     ),
     GeneralRequirement(
         "Continuous monitoring of the driver state",
+        "continuous monitoring",
         ("vats_70.warns",),
         basis="every frame is judged: VATS adds up five glances over 15 s",
     ),
     GeneralRequirement(
         "Speed activation condition for the distraction, microsleep, sleep and unresponsive "
         "driver states",
+        "speed activation of distraction, microsleep, sleep, unresponsive",
         missing="the protocol's activation speed was not read here; roadgaze's 20 km/h "
         "(min_speed_kmh) is its own choice",
     ),
     GeneralRequirement(
         "Speed activation condition for the impairment driver states, when the vehicle is moving "
         "forward at a speed of at least 50 km/h",
+        "speed activation of impairment (>= 50 km/h)",
         missing="no impairment (drowsiness) rule yet",
     ),
     GeneralRequirement(
         "Assisted Driving prerequisite (≥50% of Driving collaboration and ≥50% of Driver "
         "monitoring)",
+        "assisted driving prerequisite",
         integrator="assisted driving and its driving collaboration are the vehicle's",
     ),
     GeneralRequirement(
         f"{_INFORM} after the driver obstructs the sensor by gripping the upper portion of the "
         "steering wheel",
+        "notice: hand on the wheel at 12 o'clock",
         noise="Hand on wheel at 12 o'clock position",
         missing=_NO_NOTICE,
     ),
-    GeneralRequirement(f"{_INFORM} after the driver wears a cap", noise="Cap", missing=_NO_NOTICE),
-    GeneralRequirement(f"{_INFORM} after the driver wears a hat", noise="Hat", missing=_NO_NOTICE),
+    GeneralRequirement(
+        f"{_INFORM} after the driver wears a cap",
+        "notice: cap",
+        noise="Cap",
+        missing=_NO_NOTICE,
+    ),
+    GeneralRequirement(
+        f"{_INFORM} after the driver wears a hat",
+        "notice: hat",
+        noise="Hat",
+        missing=_NO_NOTICE,
+    ),
     GeneralRequirement(
         f"{_INFORM} after the driver wears dark sunglasses",
+        "notice: dark sunglasses",
         noise="Dark sunglasses",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         f"{_INFORM} for a driver with long head hair fringe obscuring eyes",
+        "notice: hair fringe",
         noise="Long head hair fringe obscuring eyes",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         f"{_INFORM} for a driver with thick eyelash makeup",
+        "notice: eyelash makeup",
         noise="Thick eyelash makeup",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         "Visual information about non-functional system shown permanently or every [10] minutes",
+        "notice shown permanently or every 10 minutes",
         missing=_NO_NOTICE,
     ),
 )

@@ -134,8 +134,6 @@ def _template(args: argparse.Namespace, config: Config, out_dir: Path) -> Path |
         if args.score:
             raise ConfigError("--score scores the dossier: pass --dossier FILE.xlsx too")
         return None
-    import openpyxl
-
     from roadgaze.conformance.dossier_score import Calculator, require_calculator
     from roadgaze.conformance.dossier_xlsx import check_template
 
@@ -147,6 +145,8 @@ def _template(args: argparse.Namespace, config: Config, out_dir: Path) -> Path |
     if config.monitor.protocol == "addw":
         raise ConfigError("--dossier needs Euro NCAP's rules: pass --protocol euroncap (or both)")
     require_calculator()
+    import openpyxl  # installed with the calculator
+
     template = Calculator(out_dir / "euroncap").template()
     wb = openpyxl.load_workbook(template)
     try:

@@ -1,9 +1,12 @@
-"""`roadgaze conformance [--protocol P] [--out DIR] [--fast]`: the protocols' requirements, checked.
+"""`roadgaze conformance [--protocol P] [--out DIR] [--fast] [--dossier FILE [--score]]`: the
+protocols' requirements, checked.
 
 Renders the scenario matrix (`roadgaze.conformance.matrix`) with the synthetic renderer, runs the
 service on every clip at its speed and prints, for every requirement, its source, the expected
 window, the measured warning time and PASS/FAIL; writes DIR/conformance.md and
-DIR/conformance.json (and keeps the clips, their truth and speed tracks in DIR/clips). Exit
+DIR/conformance.json (and keeps the clips, their truth and speed tracks in DIR/clips). With
+`--dossier FILE` it fills Euro NCAP's driver-monitoring prediction sheet from the run (and
+DIR/dossier.md); `--score` scores it with Euro NCAP's rating calculator (docs/euroncap.md). Exit
 status 1 when any requirement fails, 2 for bad arguments.
 """
 
@@ -63,6 +66,19 @@ def register(subparsers: Any) -> None:
         metavar="NAME",
         help="only the scenario NAME (repeatable; names as in the table)",
     )
+    parser.add_argument(
+        "--dossier",
+        type=Path,
+        metavar="FILE.xlsx",
+        help="fill Euro NCAP's driver-monitoring prediction sheet (the template of the rating "
+        "calculator, roadgaze[euroncap]) from the run: GREEN only where measured passing",
+    )
+    parser.add_argument(
+        "--score",
+        action="store_true",
+        help="score the dossier with Euro NCAP's rating calculator (its verification tests "
+        "answered by the service) and print 'Driver Monitoring: X / 25 points'",
+    )
     parser.set_defaults(handler=run)
 
 
@@ -91,6 +107,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     out_dir: Path = args.out
     if out_dir.is_file():
         raise ConfigError(f"--out {out_dir} is a file; pass a folder")
+    template = _template(args, config, out_dir)
     eyes = EyeRenderer(load_photo(), SIZE, config=config, eyeball_at_rest=True)
     renderer = ScenarioRenderer(eyes, FPS, config.monitor.cabin)
 
@@ -106,4 +123,80 @@ def run(args: argparse.Namespace, config: Config) -> int:
     log.info("conformance: %s", summary_line(suite, protocol))
     for path in write_reports(suite, protocol, FPS, out_dir):
         log_written(path)
+    if template is not None:
+        _dossier(args, config, suite.outcomes, renderer, template, out_dir)
     return EXIT_FAILED if suite.failed else 0
+
+
+def _template(args: argparse.Namespace, config: Config, out_dir: Path) -> Path | None:
+    """With --dossier: the checked template of the installed calculator (before any drive)."""
+    if args.dossier is None:
+        if args.score:
+            raise ConfigError("--score scores the dossier: pass --dossier FILE.xlsx too")
+        return None
+    from roadgaze.conformance.dossier_score import Calculator, require_calculator
+    from roadgaze.conformance.dossier_xlsx import check_template
+
+    dossier: Path = args.dossier
+    if dossier.suffix.lower() != ".xlsx" or dossier.is_dir():
+        raise ConfigError(f"--dossier {dossier}: expected a FILE.xlsx (the calculator's format)")
+    if not dossier.parent.resolve().is_dir():
+        raise ConfigError(f"--dossier {dossier}: the folder {dossier.parent} does not exist")
+    if config.monitor.protocol == "addw":
+        raise ConfigError("--dossier needs Euro NCAP's rules: pass --protocol euroncap (or both)")
+    require_calculator()
+    import openpyxl  # installed with the calculator
+
+    template = Calculator(out_dir / "euroncap").template()
+    wb = openpyxl.load_workbook(template)
+    try:
+        check_template(wb)
+    finally:
+        wb.close()
+    return template
+
+
+def _dossier(
+    args: argparse.Namespace,
+    config: Config,
+    outcomes: tuple[Any, ...],
+    renderer: Any,
+    template: Path,
+    out_dir: Path,
+) -> None:
+    """Judge the dossier from the run, write it (and DIR/dossier.md), score it with --score."""
+    from roadgaze.conformance.dossier import judge, with_gates_met
+    from roadgaze.conformance.dossier_report import dossier_markdown, score_lines
+    from roadgaze.conformance.dossier_score import Calculator, score
+    from roadgaze.conformance.dossier_xlsx import write_dossier
+    from roadgaze.conformance.matrix import scenario_matrix
+    from roadgaze.conformance.run import run_suite
+
+    runs: dict[str, list[Any]] = {}
+
+    def runner(batch: Any) -> list[Any]:
+        for scenario in batch:
+            if scenario.name not in runs:
+                log.info("conformance: running %s again for the dossier", scenario.name)
+                suite = run_suite([scenario], config, out_dir / "clips", renderer)
+                runs[scenario.name] = list(suite.outcomes)
+        return [outcome for scenario in batch for outcome in runs[scenario.name]]
+
+    scenarios = scenario_matrix(config.monitor)
+    dossier = judge(outcomes, scenarios, runner, config.monitor.cabin)
+    log_written(write_dossier(template, dossier, args.dossier))
+    markdown = dossier_markdown(dossier)
+    print(f"\n{markdown}", flush=True)
+    (out_dir / "dossier.md").write_text(markdown, encoding="utf-8")
+    log_written(out_dir / "dossier.md")
+    if not args.score:
+        return
+    work = out_dir / "euroncap"
+    official = score(dossier, args.dossier, Calculator(work), scenarios, runner)
+    log_written(official.report)
+    alone = None
+    if dossier.gates():
+        opened = with_gates_met(dossier)
+        copy = write_dossier(template, opened, work / "rows-alone.xlsx")
+        alone = score(opened, copy, Calculator(work / "rows-alone"), scenarios, runner, True).score
+    print("\n".join(score_lines(official, dossier, alone)), flush=True)

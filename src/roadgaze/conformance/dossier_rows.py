@@ -1,0 +1,312 @@
+"""Euro NCAP 2026's driver-monitoring prediction sheet, row by row, and what roadgaze measures
+for each of its cells. Pure data.
+
+The sheet is "DE - DM pred." of the Safe Driving template of Euro NCAP's rating calculator
+(`euroncap-rating-2026`, `data/sd_template.xlsx`). Each `SheetRow` is one row of it: where it is
+(the sheet's own row number), what it names (table, task, movement type, gaze location or
+impairment type), the protocol rules roadgaze runs for it, and for each of its three cells the
+conformance requirements (`Requirement.key` of `roadgaze.conformance.matrix`) that must all PASS
+for the cell to be GREEN. `()` means nothing measures the cell yet (RED); `NA` marks a cell the
+sheet leaves out (no input: a driving-task glance earns no warning points). `{driver}` and
+`{passenger}` in a key stand for the cabin's sides (`left`/`right` in a left-hand-drive cabin).
+
+**Adding a scenario for a row is adding its requirement key to that row's tuple.**
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+from roadgaze.conformance.model import Scenario
+from roadgaze.monitor.protocols import Rule, euroncap
+
+SHEET = "DE - DM pred."
+"""The prediction sheet's name in the template."""
+
+Evidence = tuple[str, ...] | None
+"""The requirement keys a cell needs, all PASS; `()` nothing yet; `NA` not in the sheet."""
+NA: Evidence = None
+
+LONG, SHORT, PHONE, NON_TRANSIENT = (
+    "Long distraction",
+    "Short distraction",
+    "Phone use",
+    "Non-transient",
+)
+TABLES = {LONG: 15, SHORT: 33, PHONE: 49, NON_TRANSIENT: 66}
+"""Each table's title row in the sheet (the column headers are on the row after it)."""
+CELL_COLUMNS = ("D", "E", "F")
+TRANSIENT_HEADERS = ("Warning", "Forward support", "Lane support")
+NON_TRANSIENT_HEADERS = ("Warning", "Forward and lane support", "Emergency function")
+
+LD, VATS = (euroncap.LONG_DISTRACTION,), (euroncap.VATS,)
+UNRESPONSIVE = (euroncap.UNRESPONSIVE_CLOSED, euroncap.UNRESPONSIVE_AFTER_WARNING)
+
+
+@dataclass(frozen=True, slots=True)
+class SheetRow:
+    """One row of the prediction sheet and the evidence behind each of its three cells."""
+
+    row: int
+    table: str
+    task: str
+    """Column A: "Non-driving task", "Driving task", "Multi-target", "Basic phone use", ...;
+    in the non-transient table "Impairment", "Microsleep", "Sleep", "Unresponsive"."""
+    movement: str
+    """Column B: "Owl", "Lizard", "Body lean" ("" in the non-transient table)."""
+    location: str
+    """Column C: the gaze location, or the impairment type ("" where the sheet has none)."""
+    rules: tuple[Rule, ...]
+    """The protocol rules roadgaze runs for the row (empty: no behaviour yet)."""
+    cells: tuple[Evidence, Evidence, Evidence]
+    """Warning, forward support, lane support (non-transient: warning, forward and lane
+    support, emergency function)."""
+
+    @property
+    def headers(self) -> tuple[str, str, str]:
+        return NON_TRANSIENT_HEADERS if self.table == NON_TRANSIENT else TRANSIENT_HEADERS
+
+    @property
+    def name(self) -> str:
+        """The row as the sheet reads it: task / movement / location."""
+        return " / ".join(part for part in (self.task, self.movement, self.location) if part)
+
+
+def _row(
+    row: int,
+    table: str,
+    task: str,
+    movement: str,
+    location: str,
+    rules: tuple[Rule, ...],
+    warning: Evidence = (),
+    forward: Evidence = (),
+    lane: Evidence = (),
+) -> SheetRow:
+    return SheetRow(row, table, task, movement, location, rules, (warning, forward, lane))
+
+
+ND, DT = "Non-driving task", "Driving task"
+_LONG_ROWS = (
+    _row(17, LONG, ND, "Owl", "Driver side window", LD, ("side_{driver}_70.warns",)),
+    _row(18, LONG, ND, "Owl", "In-vehicle infotainment system", LD, ("centre_stack_70.warns",)),
+    _row(19, LONG, ND, "Owl", "Passenger footwell", LD),
+    _row(20, LONG, ND, "Owl", "Passenger face", LD),
+    _row(21, LONG, ND, "Owl", "Passenger side window", LD, ("side_{passenger}_70.warns",)),
+    _row(22, LONG, ND, "Lizard", "In-vehicle infotainment system", LD),
+    _row(23, LONG, ND, "Lizard", "Glovebox", LD),
+    _row(24, LONG, ND, "Body lean", "Passenger footwell", LD),
+    _row(25, LONG, ND, "Body lean", "Rear passenger", LD),
+    _row(26, LONG, DT, "Owl", "Driver side mirror", (), NA),
+    _row(27, LONG, DT, "Owl", "Rear view mirror", (), NA),
+    _row(28, LONG, DT, "Owl", "Passenger side mirror", (), NA),
+    _row(29, LONG, DT, "Lizard", "Driver side mirror", (), NA),
+    _row(30, LONG, DT, "Lizard", "Instrument cluster", (), NA),
+    _row(31, LONG, DT, "Lizard", "Rear view mirror", (), NA),
+)
+_VATS_INFOTAINMENT = ("vats_70.warns", "vats_70.no_long", "vats_below_70.quiet")
+_SHORT_ROWS = (
+    _row(35, SHORT, ND, "Owl", "In-vehicle infotainment system", VATS, _VATS_INFOTAINMENT),
+    _row(36, SHORT, ND, "Owl", "Passenger footwell", VATS),
+    _row(37, SHORT, ND, "Lizard", "In-vehicle infotainment system", VATS),
+    _row(38, SHORT, ND, "Lizard", "Passenger footwell", VATS),
+    _row(39, SHORT, DT, "Owl", "Driver side mirror", (), NA),
+    _row(40, SHORT, DT, "Owl", "Rear view mirror", (), NA),
+    _row(41, SHORT, DT, "Owl", "Passenger side mirror", (), NA),
+    _row(42, SHORT, DT, "Owl", "Passenger side window", (), NA),
+    _row(43, SHORT, DT, "Lizard", "Driver side window", (), NA),
+    _row(44, SHORT, DT, "Lizard", "Driver side mirror", (), NA),
+    _row(45, SHORT, DT, "Lizard", "Instrument cluster", (), NA),
+    _row(46, SHORT, DT, "Lizard", "Rear view mirror", (), NA),
+    _row(47, SHORT, "Multi-target", "Lizard", "", VATS),
+)
+BASIC, ADVANCED = "Basic phone use", "Advanced phone use"
+_PHONE_ROWS = (
+    _row(51, PHONE, BASIC, "Owl", "Phone mounted on dashboard outboard", ()),
+    _row(52, PHONE, BASIC, "Owl", "Driver knee outboard", ()),
+    _row(53, PHONE, BASIC, "Owl", "Driver lap", ()),
+    _row(54, PHONE, BASIC, "Owl", "Driver inboard", ()),
+    _row(55, PHONE, BASIC, "Owl", "Phone mounted on dedicated position", ()),
+    _row(56, PHONE, BASIC, "Lizard", "Driver knee outboard", ()),
+    _row(57, PHONE, BASIC, "Lizard", "Driver lap", ()),
+    _row(58, PHONE, BASIC, "Lizard", "Driver inboard", ()),
+    _row(59, PHONE, BASIC, "Lizard", "Phone mounted on dedicated position", ()),
+    _row(60, PHONE, BASIC, "Lizard", "Phone held centre of steering wheel", ()),
+    _row(61, PHONE, ADVANCED, "Lizard", "Phone mounted on dashboard outboard", ()),
+    _row(62, PHONE, ADVANCED, "Lizard", "Phone held in 9-11 or 1-3 o'clock", ()),
+    _row(63, PHONE, ADVANCED, "Lizard", "Phone held in view of windscreen", ()),
+    _row(64, PHONE, ADVANCED, "Lizard", "Phone held in view of instrument cluster", ()),
+)
+_MICROSLEEP = ("microsleep_70.warns", "microsleep_70.no_sleep")
+_UNRESPONSIVE = ("unresponsive_closed_70.warns", "unresponsive_away_70.warns")
+_NON_TRANSIENT_ROWS = (
+    _row(68, NON_TRANSIENT, "Impairment", "", "Drowsiness", (), (), (), NA),
+    _row(69, NON_TRANSIENT, "Impairment", "", "Non-fatigue", (), (), (), NA),
+    _row(70, NON_TRANSIENT, "Microsleep", "", "", (euroncap.MICROSLEEP,), _MICROSLEEP, (), NA),
+    _row(71, NON_TRANSIENT, "Sleep", "", "", (euroncap.SLEEP,), ("sleep_70.warns",), (), NA),
+    _row(72, NON_TRANSIENT, "Unresponsive", "", "", UNRESPONSIVE, NA, NA, _UNRESPONSIVE),
+)
+ROWS: tuple[SheetRow, ...] = (*_LONG_ROWS, *_SHORT_ROWS, *_PHONE_ROWS, *_NON_TRANSIENT_ROWS)
+"""Every row of the sheet that takes a prediction, in sheet order."""
+
+
+def dark_sunglasses(scenario: Scenario) -> Scenario:
+    """The scenario with the driver in dark sunglasses from the first frame."""
+    return replace(scenario, name=f"{scenario.name}__dark_sunglasses", sunglasses=True)
+
+
+@dataclass(frozen=True, slots=True)
+class NoiseVariable:
+    """A row of the sheet's noise-variable table: the system works ("Functional") or not under
+    it. `variant` renders a scenario under it (None: roadgaze cannot render it yet, so it is
+    not shown functional)."""
+
+    row: int
+    element: str
+    mandatory: bool
+    """The calculator scores Driver Monitoring 0 unless this one is Functional."""
+    variant: Callable[[Scenario], Scenario] | None = None
+
+
+NOISE_VARIABLES: tuple[NoiseVariable, ...] = (
+    NoiseVariable(2, "Daytime - Night-time", True),
+    NoiseVariable(3, "Clear sunglasses", True),
+    NoiseVariable(4, "Dark sunglasses", False, dark_sunglasses),
+    NoiseVariable(5, "Short facial hair", True),
+    NoiseVariable(6, "Long facial hair", True),
+    NoiseVariable(7, "Hand on wheel at 12 o'clock position", False),
+    NoiseVariable(8, "Face-mask", True),
+    NoiseVariable(9, "Cap", False),
+    NoiseVariable(10, "Hat", False),
+    NoiseVariable(11, "Long head hair fringe obscuring eyes", False),
+    NoiseVariable(12, "Thick eyelash makeup", False),
+    NoiseVariable(13, "Talking", False),
+)
+"""The sheet's rows 2-13 ("Talking" is named in column B, the others in column C)."""
+
+
+@dataclass(frozen=True, slots=True)
+class GeneralRequirement:
+    """A general requirement of the verification sheet ("DE - DM verif."), in the calculator's
+    own words, and how roadgaze answers it: PASS when every `evidence` key passed; without
+    evidence, PASS on `basis` (a property of the service) or on `integrator` (the vehicle's
+    part, taken as met and printed with the score); N/A when `noise` names a noise variable
+    the dossier states Functional; otherwise FAIL, `missing` saying what is not there."""
+
+    text: str
+    label: str
+    """A few words for the score's summary."""
+    evidence: tuple[str, ...] = ()
+    basis: str = ""
+    integrator: str = ""
+    noise: str = ""
+    missing: str = ""
+
+
+_INFORM = "Inform with visual and/or auditory cues of non functional system within 10 seconds"
+_NO_NOTICE = "no non-functional notice yet (its rule and scenario are still to come)"
+GENERAL_REQUIREMENTS: tuple[GeneralRequirement, ...] = (
+    GeneralRequirement(
+        "Default ON at the start of every journey",
+        "on by default",
+        ("lap_70.warns",),
+        basis="the service monitors from its first frame; no setting turns monitoring off",
+    ),
+    GeneralRequirement(
+        "Deactivation is not possible with a momentary single push on a button",
+        "no off by a single push",
+        integrator="the service has no off switch; the vehicle's buttons are the integrator's",
+    ),
+    GeneralRequirement(
+        "Detection sensitivity shall not be manually adjustable",
+        "sensitivity not adjustable",
+        integrator="the service takes no driver input; its settings are the integrator's",
+    ),
+    GeneralRequirement(
+        "Continuous monitoring of the driver state",
+        "continuous monitoring",
+        ("vats_70.warns",),
+        basis="every frame is judged: VATS adds up five glances over 15 s",
+    ),
+    GeneralRequirement(
+        "Speed activation condition for the distraction, microsleep, sleep and unresponsive "
+        "driver states",
+        "speed activation of distraction, microsleep, sleep, unresponsive",
+        missing="the protocol's activation speed was not read here; roadgaze's 20 km/h "
+        "(min_speed_kmh) is its own choice",
+    ),
+    GeneralRequirement(
+        "Speed activation condition for the impairment driver states, when the vehicle is moving "
+        "forward at a speed of at least 50 km/h",
+        "speed activation of impairment (>= 50 km/h)",
+        missing="no impairment (drowsiness) rule yet",
+    ),
+    GeneralRequirement(
+        "Assisted Driving prerequisite (≥50% of Driving collaboration and ≥50% of Driver "
+        "monitoring)",
+        "assisted driving prerequisite",
+        integrator="assisted driving and its driving collaboration are the vehicle's",
+    ),
+    GeneralRequirement(
+        f"{_INFORM} after the driver obstructs the sensor by gripping the upper portion of the "
+        "steering wheel",
+        "notice: hand on the wheel at 12 o'clock",
+        noise="Hand on wheel at 12 o'clock position",
+        missing=_NO_NOTICE,
+    ),
+    GeneralRequirement(
+        f"{_INFORM} after the driver wears a cap",
+        "notice: cap",
+        noise="Cap",
+        missing=_NO_NOTICE,
+    ),
+    GeneralRequirement(
+        f"{_INFORM} after the driver wears a hat",
+        "notice: hat",
+        noise="Hat",
+        missing=_NO_NOTICE,
+    ),
+    GeneralRequirement(
+        f"{_INFORM} after the driver wears dark sunglasses",
+        "notice: dark sunglasses",
+        noise="Dark sunglasses",
+        missing=_NO_NOTICE,
+    ),
+    GeneralRequirement(
+        f"{_INFORM} for a driver with long head hair fringe obscuring eyes",
+        "notice: hair fringe",
+        noise="Long head hair fringe obscuring eyes",
+        missing=_NO_NOTICE,
+    ),
+    GeneralRequirement(
+        f"{_INFORM} for a driver with thick eyelash makeup",
+        "notice: eyelash makeup",
+        noise="Thick eyelash makeup",
+        missing=_NO_NOTICE,
+    ),
+    GeneralRequirement(
+        "Visual information about non-functional system shown permanently or every [10] minutes",
+        "notice shown permanently or every 10 minutes",
+        missing=_NO_NOTICE,
+    ),
+)
+
+ASSUMPTIONS = (
+    "forward and lane support count the service's support request (the vehicle's reaction is "
+    "the integrator's)",
+    "the emergency function counts the service's `unresponsive` alert as its request (the "
+    "vehicle's manoeuvre is the integrator's)",
+)
+"""Printed with every score: what the service's part is taken to stand for."""
+
+
+def key_for(key: str, cabin: str) -> str:
+    """`key` with `{driver}` and `{passenger}` replaced by the cabin's sides."""
+    driver, passenger = ("left", "right") if cabin == "lhd" else ("right", "left")
+    return key.replace("{driver}", driver).replace("{passenger}", passenger)
+
+
+def row_at(row: int) -> SheetRow | None:
+    """The sheet row at `row` (None: not a prediction row)."""
+    return next((r for r in ROWS if r.row == row), None)

@@ -1,0 +1,112 @@
+"""The dossier judged from outcomes: GREEN only where every requirement behind a cell passed,
+noise variables Functional only where every GREEN cell passed again under them, the general
+requirements answered with their basis (`roadgaze.conformance.dossier`)."""
+
+from __future__ import annotations
+
+import pytest
+
+from dossier_fakes import FakeRunner, euroncap_scenarios, outcomes_of
+from roadgaze.conformance.dossier import (
+    GREEN,
+    RED,
+    judge,
+    judge_cells,
+    outcomes_by_key,
+    with_gates_met,
+)
+
+SCENARIOS = euroncap_scenarios()
+
+
+@pytest.mark.parametrize(
+    ("failed", "not_applicable", "colour", "why"),
+    [
+        ((), (), GREEN, "PASS: side_left_70.warns 2.00 s"),
+        (("side_left_70.warns",), (), RED, "FAIL: side_left_70.warns 2.00 s (FAIL)"),
+        ((), ("side_left_70.warns",), RED, "FAIL: side_left_70.warns 2.00 s (N/A)"),
+    ],
+)
+def test_a_cell_is_green_only_when_its_requirement_passed(
+    failed: tuple[str, ...], not_applicable: tuple[str, ...], colour: str, why: str
+) -> None:
+    results = outcomes_by_key(outcomes_of(SCENARIOS, failed, not_applicable))
+    cells = {(c.row.row, c.column): c for c in judge_cells(results, "lhd")}
+    driver_window = cells[(17, "D")]
+    assert (driver_window.colour, driver_window.why) == (colour, why)
+    assert driver_window.keys == ("side_left_70.warns",)
+
+
+def test_every_requirement_of_a_cell_must_pass_and_be_run() -> None:
+    results = outcomes_by_key(outcomes_of(SCENARIOS, failed=("vats_below_70.quiet",)))
+    vats = {(c.row.row, c.column): c for c in judge_cells(results, "lhd")}[(35, "D")]
+    assert vats.colour == RED and "vats_below_70.quiet" in vats.why
+    not_run = [o for o in outcomes_of(SCENARIOS) if o.scenario != "sleep_70"]
+    sleep = {(c.row.row, c.column): c for c in judge_cells(outcomes_by_key(not_run), "lhd")}
+    assert (sleep[(71, "D")].colour, sleep[(71, "D")].why) == (RED, "not run: sleep_70.warns")
+
+
+def test_cells_without_a_scenario_are_red_and_the_sheets_gaps_are_left_out() -> None:
+    cells = {(c.row.row, c.column): c for c in judge_cells(outcomes_by_key([]), "lhd")}
+    assert all(c.colour in (RED, None) for c in cells.values())
+    assert (cells[(19, "D")].colour, cells[(19, "D")].why) == (RED, "no scenario measures it yet")
+    assert cells[(26, "D")].colour is None  # a mirror glance earns no warning points
+    assert cells[(72, "D")].colour is None and cells[(68, "F")].colour is None
+    assert len(cells) == 47 * 3
+
+
+def test_a_right_hand_drive_cabin_swaps_the_driver_and_passenger_sides() -> None:
+    scenarios = euroncap_scenarios("rhd")
+    results = outcomes_by_key(outcomes_of(scenarios, failed=("side_left_70.warns",)))
+    cells = {(c.row.row, c.column): c for c in judge_cells(results, "rhd")}
+    assert cells[(17, "D")].keys == ("side_right_70.warns",) and cells[(17, "D")].colour == GREEN
+    assert cells[(21, "D")].keys == ("side_left_70.warns",) and cells[(21, "D")].colour == RED
+
+
+def test_noise_variables_are_functional_only_when_every_green_cell_passes_under_them() -> None:
+    runner = FakeRunner()
+    dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
+    sunglasses = dossier.noise_of("Dark sunglasses")
+    assert sunglasses is not None and sunglasses.performance == "Functional"
+    assert all(name.endswith("__dark_sunglasses") for name in runner.calls)
+    green = {key.split(".")[0] for c in dossier.cells if c.colour == GREEN for key in c.keys}
+    assert {name.removesuffix("__dark_sunglasses") for name in runner.calls} == green
+    unrendered = [n for n in dossier.noise if n.variable.variant is None]
+    assert unrendered and all(n.performance == "Non Functional" for n in unrendered)
+
+
+def test_a_noise_variable_stops_at_the_first_scenario_failing_under_it() -> None:
+    runner = FakeRunner(failing={"microsleep_70__dark_sunglasses"})
+    dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
+    sunglasses = dossier.noise_of("Dark sunglasses")
+    assert sunglasses is not None and not sunglasses.functional
+    assert sunglasses.why.startswith("microsleep_70__dark_sunglasses: FAIL: microsleep_70.warns")
+    assert runner.calls == ["microsleep_70__dark_sunglasses"]  # the shortest drive goes first
+
+
+def test_general_requirements_answer_pass_fail_or_na_with_their_basis() -> None:
+    outcomes = outcomes_of(SCENARIOS, failed=("lap_70.warns",))
+    dossier = judge(outcomes, SCENARIOS, FakeRunner(), "lhd")
+    answers = {g.requirement.text: g for g in dossier.general}
+    assert answers["Default ON at the start of every journey"].value == "FAIL"
+    assert answers["Continuous monitoring of the driver state"].value == "PASS"
+    assisted = next(g for text, g in answers.items() if text.startswith("Assisted Driving"))
+    assert assisted.value == "PASS" and assisted.why.startswith("taken as met")
+    sunglasses = next(g for text, g in answers.items() if text.endswith("dark sunglasses"))
+    assert sunglasses.value == "N/A"  # dark sunglasses shown functional: nothing to inform of
+    cap = next(g for text, g in answers.items() if text.endswith("wears a cap"))
+    assert cap.value == "FAIL"
+
+
+def test_the_gates_name_what_holds_the_score_and_can_be_taken_as_met() -> None:
+    dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, FakeRunner(), "lhd")
+    gates = dossier.gates()
+    assert gates[0] == (
+        "mandatory noise variables not shown functional: Daytime - Night-time, Clear "
+        "sunglasses, Short facial hair, Long facial hair, Face-mask"
+    )
+    assert gates[1].startswith("8 general requirements not met: speed activation of distraction")
+    opened = with_gates_met(dossier)
+    assert opened.gates() == [] and opened.cells == dossier.cells
+    cap = opened.noise_of("Cap")
+    assert cap is not None and not cap.functional  # only the mandatory ones are taken as met

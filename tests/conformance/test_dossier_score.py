@@ -1,0 +1,72 @@
+"""The dossier scored by Euro NCAP's own calculator (`roadgaze.conformance.dossier_score`): the
+real `euroncap_rating_2026` command line selects the tests, each is answered by running its
+scenarios again (here a runner that answers without the service: the service itself is the
+conformance suite's), and its report's Driver Monitoring score is read back."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from dossier_fakes import FakeRunner, euroncap_scenarios, outcomes_of
+from roadgaze.conformance import dossier_score
+from roadgaze.conformance.dossier import judge, with_gates_met
+from roadgaze.conformance.dossier_score import Calculator, require_calculator, score
+from roadgaze.conformance.dossier_xlsx import write_dossier
+from roadgaze.errors import ConfigError
+
+SCENARIOS = euroncap_scenarios()
+
+
+@pytest.mark.parametrize(
+    ("version", "said"),
+    [
+        (None, "--dossier and --score need Euro NCAP's rating calculator: pip install"),
+        ("5.5.0", "euroncap-rating-2026 5.5.0 is installed; roadgaze's dossier reads the sheet"),
+    ],
+)
+def test_without_the_pinned_calculator_one_line_says_how_to_install_it(
+    monkeypatch: pytest.MonkeyPatch, version: str | None, said: str
+) -> None:
+    monkeypatch.setattr(dossier_score, "installed_version", lambda: version)
+    with pytest.raises(ConfigError) as raised:
+        require_calculator()
+    assert str(raised.value).startswith(said) and "'.[euroncap]'" in str(raised.value)
+
+
+@pytest.mark.slow
+def test_the_calculator_pays_the_rows_whose_tests_pass_again(tmp_path: Path) -> None:
+    """Microsleep and sleep warnings (0.5 each) and the unresponsive driver's emergency function
+    (2.0) are the GREEN rows whose whole group is GREEN: 3 points with the gates taken as met;
+    a sleep test failing when run again takes its 0.5."""
+    pytest.importorskip("euroncap_rating_2026", reason="needs roadgaze[euroncap]")
+    assert require_calculator() == dossier_score.PINNED
+    template = Calculator(tmp_path / "template").template()
+    dossier = with_gates_met(judge(outcomes_of(SCENARIOS), SCENARIOS, FakeRunner(), "lhd"))
+    path = write_dossier(template, dossier, tmp_path / "d.xlsx")
+
+    runner = FakeRunner()
+    passed = score(dossier, path, Calculator(tmp_path / "pass"), SCENARIOS, runner, True)
+    assert passed.score.points == 3.0 and passed.score.max_points == 25.0
+    assert {(a.column, a.row, a.value) for a in passed.answers} == {
+        ("D", 70, "PASS"),
+        ("D", 71, "PASS"),
+        ("F", 72, "PASS"),
+    }
+    assert set(runner.calls) == {
+        "microsleep_70",
+        "sleep_70",
+        "unresponsive_closed_70",
+        "unresponsive_away_70",
+    }
+    categories = {name: got for name, got, _ in passed.score.categories}
+    assert categories["Non-transient - Unresponsive"] == 2.0
+    assert categories["Transient - Long distraction"] == 0.0  # footwell and face are RED
+
+    failing = FakeRunner(failing={"sleep_70"})
+    failed = score(dossier, path, Calculator(tmp_path / "fail"), SCENARIOS, failing, True)
+    assert failed.score.points == 2.5
+    sleep = next(a for a in failed.answers if a.row == 71)
+    assert sleep.value == "FAIL" and sleep.why.startswith("sleep_70: FAIL: sleep_70.warns")
+    assert (tmp_path / "fail" / "sd_verified.xlsx").is_file() and failed.report.is_file()

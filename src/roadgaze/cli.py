@@ -9,6 +9,7 @@ traceback.
 from __future__ import annotations
 
 import argparse
+import difflib
 import sys
 from collections.abc import Sequence
 
@@ -22,7 +23,10 @@ from roadgaze.logs import setup_logging
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="roadgaze",
-        description="Driver head-yaw monitoring for forward-collision warning.",
+        description=(
+            "Real-time driver monitoring for forward-collision warning: where the driver looks, "
+            "eye closure and drowsiness, by the EU ADDW and Euro NCAP rules, told over Zenoh."
+        ),
     )
     parser.add_argument("--version", action="version", version=f"roadgaze {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -31,10 +35,34 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def unknown_command(parser: argparse.ArgumentParser, argv: Sequence[str]) -> str | None:
+    """The one-line error for a mistyped command, with the nearest command names; None when the
+    command is known (or absent: argparse says what is missing)."""
+    names = [
+        name
+        for action in parser._actions
+        if isinstance(action, argparse._SubParsersAction)
+        for name in action.choices
+    ]
+    first = next((word for word in argv if not word.startswith("-")), None)
+    if first is None or first in names:
+        return None
+    near = [name for name in names if name.startswith(first)][:2] or difflib.get_close_matches(
+        first, names, n=2, cutoff=0.6
+    )
+    hint = f"did you mean {' or '.join(near)}? " if near else ""
+    return f"roadgaze: error: unknown command '{first}'; {hint}roadgaze --help lists them"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the process exit code."""
+    words = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
-    args = parser.parse_args(argv)
+    mistyped = unknown_command(parser, words)
+    if mistyped is not None:
+        print(mistyped, file=sys.stderr)
+        return 2
+    args = parser.parse_args(words)
     log_level = getattr(args, "log_level", None)
     log_json = bool(getattr(args, "log_json", False))
     setup_logging(log_level, log_json)

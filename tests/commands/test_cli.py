@@ -24,10 +24,29 @@ def test_user_errors_print_one_line_and_exit_2(
     assert err == "roadgaze paper-tables: error: geometry.beta: must be > 1 (found 0.5)\n"
 
 
-def test_unknown_command_is_a_usage_error() -> None:
-    with pytest.raises(SystemExit) as caught:
-        main(["no-such-command"])
-    assert caught.value.code == 2
+@pytest.mark.parametrize(
+    ("typed", "line"),
+    [
+        ("replya", "unknown command 'replya'; did you mean replay? roadgaze --help lists them"),
+        ("evaluate", "unknown command 'evaluate'; did you mean eval? roadgaze --help lists them"),
+        ("paper", "unknown command 'paper'; did you mean paper-tables?"),
+        ("no-such-command", "unknown command 'no-such-command'; roadgaze --help lists them"),
+    ],
+)
+def test_an_unknown_command_is_one_line_with_the_nearest_names_and_exit_2(
+    typed: str, line: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main([typed, "--help"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("roadgaze: error: ") and line in err and err.count("\n") == 1
+
+
+def test_the_help_says_what_the_tool_is(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "driver monitoring for forward-collision warning" in text
+    assert "head-yaw" not in text
 
 
 def test_module_entry_point_prints_help_quickly(subprocess_env: dict[str, str]) -> None:

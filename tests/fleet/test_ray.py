@@ -1,9 +1,18 @@
-"""The Ray engine: the same task function as Ray tasks on a real local Ray instance writes the
-same Parquet as the local engine."""
+"""The Ray engine as a user runs it: `roadgaze batch --engine ray` in a fresh process, with no
+Ray running (it starts a local instance and stops it) and with `--ray-address` to a head started
+by `ray start --head`. The test process itself never initialises Ray, so a start that only works
+where Ray is already initialised (or only on the main thread) fails here."""
 
 from __future__ import annotations
 
-import logging
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -11,32 +20,36 @@ from typing import Any
 import pyarrow.parquet as pq
 import pytest
 
-from roadgaze.config import Config
-from roadgaze.fleet import BatchOptions, discover_drives, output_paths, run_batch
+from repo_paths import child_env
+from roadgaze.fleet import output_paths
 
-ray = pytest.importorskip("ray", reason="Ray is the optional extra roadgaze[ray]")
+pytest.importorskip("ray", reason="Ray is the optional extra roadgaze[ray]")
 
 pytestmark = pytest.mark.slow
 
 TIMING = {"processing_fps", "startup_s", "wall_s"}
+CLI_TIMEOUT_S = 600.0
 
 
-@pytest.fixture(scope="session")
-def ray_instance() -> Iterator[Any]:
-    """One local Ray instance with one CPU for the whole session (about 3 s to start)."""
-    ray.init(num_cpus=1, include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR)
-    yield ray
-    ray.shutdown()
+def _batch(
+    folder: Path, out: Path, *extra: str, ray_tmp: Path | None = None
+) -> subprocess.CompletedProcess[str]:
+    env = {k: v for k, v in child_env().items() if k != "RAY_ADDRESS"}
+    if ray_tmp is not None:
+        env["RAY_TMPDIR"] = str(ray_tmp)
+    return subprocess.run(
+        [
+            *(sys.executable, "-m", "roadgaze", "batch", str(folder), "--out", str(out)),
+            *("--engine", "ray", "--no-progress", *extra),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=CLI_TIMEOUT_S,
+        env=env,
+    )
 
 
-def test_ray_tasks_write_the_same_parquet_as_the_local_engine(
-    ray_instance: Any, local_batch: Any, tmp_path: Path
-) -> None:
-    out = tmp_path / "ray-out"
-    options = BatchOptions(out_dir=out, engine="ray", progress=False)
-    outcome = run_batch(discover_drives(local_batch.input.folder), Config(), options)
-    assert ray_instance.is_initialized()  # a Ray started by the caller is left running
-    assert outcome.engine == "ray" and outcome.workers == 1
+def _assert_same_as_local(out: Path, local_batch: Any) -> None:
     for drive_id in local_batch.input.videos:
         for ray_path, local_path in zip(
             output_paths(out, drive_id), output_paths(local_batch.out_dir, drive_id), strict=True
@@ -50,3 +63,86 @@ def test_ray_tasks_write_the_same_parquet_as_the_local_engine(
         {k: v for k, v in row.items() if k not in TIMING} for row in local_rows
     ]
     assert {r["drive_id"]: r["status"] for r in ray_rows}["corrupt"] == "failed"
+
+
+def _processes_naming(text: str) -> list[str]:
+    """Command lines of the running processes that contain `text`."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+            except OSError:
+                continue
+            if text in cmdline:
+                found.append(cmdline[:120])
+    return found
+
+
+def test_a_fresh_process_with_no_ray_running_starts_one_and_equals_the_local_engine(
+    local_batch: Any, tmp_path: Path
+) -> None:
+    """The case that broke in 0.2: `ray.init` on a helper thread started a local instance
+    that the kernel killed when the thread ended (parent-death signal of that thread)."""
+    out = tmp_path / "ray-out"
+    # Ray's unix sockets live under its temp folder: keep the path short (108 bytes at most).
+    ray_tmp = Path(tempfile.mkdtemp(prefix="rg-ray-", dir="/tmp"))
+    try:
+        done = _batch(local_batch.input.folder, out, ray_tmp=ray_tmp)
+        assert done.returncode == 3, done.stderr[-2000:]  # the corrupt and empty drives fail
+        assert "on ray with" in done.stderr
+        _assert_same_as_local(out, local_batch)
+        time.sleep(2.0)  # Ray's own processes end shortly after the driver's shutdown
+        assert _processes_naming(str(ray_tmp)) == []  # the instance it started is gone
+    finally:
+        shutil.rmtree(ray_tmp, ignore_errors=True)
+
+
+@pytest.fixture
+def ray_head(tmp_path: Path) -> Iterator[str]:
+    """A real Ray head started with `ray start --head --block` in a process group of its own
+    (stopped by signalling that group, never `ray stop`, which would stop every Ray here)."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    ray_cli = Path(sys.executable).with_name("ray")
+    head = subprocess.Popen(
+        [
+            *(str(ray_cli), "start", "--head", "--block", f"--port={port}", "--num-cpus=1"),
+            *("--include-dashboard=false", "--disable-usage-stats"),
+        ],
+        stdout=(tmp_path / "ray-head.log").open("w"),
+        stderr=subprocess.STDOUT,
+        start_new_session=True,
+    )
+    try:
+        deadline = time.monotonic() + 180.0
+        while time.monotonic() < deadline:
+            try:
+                with socket.create_connection(("127.0.0.1", port), timeout=1.0):
+                    break
+            except OSError:
+                assert head.poll() is None, (tmp_path / "ray-head.log").read_text()[-2000:]
+                time.sleep(0.5)
+        else:
+            pytest.fail("ray start --head did not listen within 180 s")
+        yield f"127.0.0.1:{port}"
+    finally:
+        os.killpg(head.pid, signal.SIGTERM)
+        try:
+            head.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(head.pid, signal.SIGKILL)
+            head.wait()
+
+
+def test_a_running_head_at_an_address_is_used_and_left_running(
+    local_batch: Any, tmp_path: Path, ray_head: str
+) -> None:
+    out = tmp_path / "ray-out"
+    done = _batch(local_batch.input.folder, out, "--ray-address", ray_head, "--ray-timeout", "120")
+    assert done.returncode == 3, done.stderr[-2000:]
+    _assert_same_as_local(out, local_batch)
+    host, port = ray_head.split(":")
+    with socket.create_connection((host, int(port)), timeout=5.0):
+        pass  # the head the user started is still there

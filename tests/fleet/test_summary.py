@@ -144,3 +144,10 @@ def test_the_bar_legend_sits_beside_the_bars_and_tables_fit_the_page() -> None:
     # Kinds no drive raised take no columns (eight mostly empty columns made the tables too wide).
     assert "No drive raised microsleep, sleep, drowsy, unresponsive, degraded" in page
     assert "<th>microsleep /h</th>" not in page and "<th>vats /h</th>" in page
+
+
+def test_a_batch_without_alerts_draws_no_empty_alert_plot() -> None:
+    quiet = tuple(ok(r.drive_id, r.driver_id, alert_counts=()) for r in RESULTS if r.status == "ok")
+    page = render_report(BatchOutcome(quiet, "local", 2, wall_s=30.0, startup_s=0.0))
+    assert len(re.findall(r'src="data:image/png;base64,', page)) == 2  # the two histograms
+    assert "No drive raised an alert, so there are no alert rates to plot." in page

@@ -117,7 +117,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     if args.engine == "ray":
         from roadgaze.fleet.engines import import_ray
 
-        import_ray()  # a missing Ray is a bad argument, said before any work
+        import_ray(args.ray_address)  # a missing Ray is a bad argument, said before any work
     drives = discover_drives(args.input)
     out_dir = args.out.resolve()
     if out_dir.is_file():

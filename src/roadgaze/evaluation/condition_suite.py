@@ -136,7 +136,9 @@ def estimate_conditions(
 
     jobs = [(dataset / truth.file, truth.file) for truth in truths]
     results: list[tuple[ImageEstimate, ...]] = []
-    with tqdm(total=len(jobs), desc="conditions", unit="img", disable=not progress) as bar:
+    with tqdm(
+        total=len(jobs), desc="conditions", unit="img", disable=None if progress else True
+    ) as bar:
         if workers <= 1:
             from roadgaze.evaluation.images import still_detector
 

@@ -285,7 +285,13 @@ def estimate_images(
     from tqdm import tqdm
 
     config = config if config is not None else Config()
-    bar = tqdm(total=len(jobs), desc=description, unit="img", disable=not progress, leave=False)
+    bar = tqdm(
+        total=len(jobs),
+        desc=description,
+        unit="img",
+        disable=None if progress else True,
+        leave=False,
+    )
     try:
         if workers <= 1 or len(jobs) <= 1:
             still = StillPose.from_config(config)

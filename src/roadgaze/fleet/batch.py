@@ -124,9 +124,9 @@ class BatchProgress:
     """A tqdm bar over drives on stderr: drives done, frames/s of the batch so far, ETA."""
 
     def __init__(self, total: int, enabled: bool) -> None:
-        from tqdm import tqdm
+        from roadgaze.outputs.progress import terminal_bar
 
-        self._bar = tqdm(total=total, desc="drives", unit="drive", disable=not enabled)
+        self._bar = terminal_bar(total, "drives", "drive", enabled)
         self._start = time.perf_counter()
         self.frames = 0
         self.failed = 0

@@ -27,7 +27,7 @@ from types import TracebackType
 from typing import Any, Protocol
 
 from roadgaze.errors import ConfigError, RoadgazeError
-from roadgaze.fleet.ray_connect import bounded_call, wait_for_ray_head
+from roadgaze.fleet.ray_connect import KeeperThread, use_ray_token, wait_for_ray_head
 from roadgaze.fleet.results import DriveResult
 from roadgaze.fleet.task import DriveTask, one_line, process_drive, use_stop_signal
 from roadgaze.pipeline import StopSignal
@@ -40,6 +40,10 @@ POLL_S = 0.2
 RAY_MISSING = "the ray engine needs Ray, which is not installed: pip install 'roadgaze[ray]'"
 RAY_TIMEOUT_S = 30.0
 """How long `batch --engine ray` waits for a Ray cluster at an address (`--ray-timeout`)."""
+LOCAL_RAY_START_S = 180.0
+"""How long starting a local Ray instance may take at most (Ray's own bound is 60 s per step; a
+loaded 2-core machine took 28 s where an idle one takes about 5), unless `--ray-timeout` is
+longer."""
 
 
 class Engine(Protocol):
@@ -249,8 +253,12 @@ def stderr_to(path: Path) -> Iterator[None]:
         os.close(saved)
 
 
-def import_ray() -> Any:
-    """The `ray` module; ConfigError saying how to install it when it is missing."""
+def import_ray(address: str | None = None) -> Any:
+    """The `ray` module; ConfigError saying how to install it when it is missing. With a cluster
+    to reach (`address`, or `RAY_ADDRESS`), Ray is first told to send its authentication token
+    where one is at hand (`use_ray_token`: Ray reads the mode when it loads)."""
+    if address is not None or os.environ.get("RAY_ADDRESS"):
+        use_ray_token(os.environ, Path.home())
     try:
         import ray
     except ImportError:
@@ -283,24 +291,28 @@ class RayEngine:
         self.retries = retries
         self._ray: Any = None
         self._started_here = False
+        self._keeper: KeeperThread | None = None
 
     def __enter__(self) -> RayEngine:
         os.environ.setdefault("RAY_BACKEND_LOG_LEVEL", "error")  # before Ray's core loads
-        ray = self._ray = import_ray()
+        ray = self._ray = import_ray(self.address)
         if not ray.is_initialized():
             options: dict[str, Any] = {"log_to_driver": False, "logging_level": logging.ERROR}
             if self.address is None and not os.environ.get("RAY_ADDRESS"):
                 options["include_dashboard"] = False
             where = self.address or os.environ.get("RAY_ADDRESS") or "a local instance"
-            deadline = time.monotonic() + self.timeout_s
-            if where != "a local instance":
+            local = where == "a local instance"
+            bound_s = max(self.timeout_s, LOCAL_RAY_START_S) if local else self.timeout_s
+            deadline = time.monotonic() + bound_s
+            if not local:
                 wait_for_ray_head(where, deadline, self.timeout_s)
             try:
                 with stderr_to(self._log_path):
-                    bounded_call(lambda: ray.init(address=self.address, **options), deadline)
+                    keeper = KeeperThread(lambda: ray.init(address=self.address, **options))
+                    self._keeper = keeper.start(deadline)
             except TimeoutError:
                 raise ConfigError(
-                    f"no Ray cluster answered at {where} within {self.timeout_s:g} s "
+                    f"no Ray cluster answered at {where} within {bound_s:g} s "
                     f"(--ray-timeout); see {self._log_path}"
                 ) from None
             except (ConnectionError, ValueError, RuntimeError) as exc:
@@ -321,6 +333,9 @@ class RayEngine:
         if self._started_here:
             self._ray.shutdown()
             self._started_here = False
+        if self._keeper is not None:
+            self._keeper.release()
+            self._keeper = None
 
     def run(self, tasks: Iterable[DriveTask], stop: StopSignal) -> Iterator[DriveResult]:
         ray = self._ray

@@ -1,7 +1,15 @@
 """Reaching a Ray cluster within a bounded time: Ray's own connect retries for minutes.
 
 `wait_for_ray_head` waits until something accepts TCP connections at the head's address (or
-fails naming it); `bounded_call` runs `ray.init` on a thread and gives up at a deadline.
+fails naming it); `KeeperThread` runs `ray.init` on a thread, gives up at a deadline, and keeps
+that thread alive until the caller is done with Ray.
+
+Why the thread must outlive the call: a local Ray instance's processes (GCS, raylet) are started
+with `prctl(PR_SET_PDEATHSIG, SIGKILL)`, and Linux sends that signal when the *thread* that
+started them ends, not the process. A `ray.init` on a short-lived thread therefore started a
+local instance that the kernel killed the moment the thread returned ("Failed to connect to GCS
+within 60 seconds"); on the main thread it worked. The keeper thread waits, after the call, until
+`release()`.
 """
 
 from __future__ import annotations
@@ -9,7 +17,8 @@ from __future__ import annotations
 import socket
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, MutableMapping
+from pathlib import Path
 
 from roadgaze.errors import ConfigError
 
@@ -22,6 +31,26 @@ def ray_head_endpoint(address: str) -> tuple[str, int] | None:
     if not host or not port.isdigit():
         return None
     return host.strip("[]"), int(port)
+
+
+def use_ray_token(environ: MutableMapping[str, str], home: Path) -> bool:
+    """Ask Ray to send its authentication token when one is at hand and the user set no mode.
+
+    Ray 2.60's `ray start --head` turns token authentication on and writes the token to
+    `~/.ray/auth_token`, but a driver connecting to it sends no token unless `RAY_AUTH_MODE` is
+    `token` ("Authentication token is missing or incorrect"). A cluster without authentication
+    accepts a driver that sends one, so sending it is never worse. Returns whether it set the
+    mode."""
+    if "RAY_AUTH_MODE" in environ:
+        return False
+    if not (
+        environ.get("RAY_AUTH_TOKEN")
+        or environ.get("RAY_AUTH_TOKEN_PATH")
+        or (home / ".ray" / "auth_token").is_file()
+    ):
+        return False
+    environ["RAY_AUTH_MODE"] = "token"
+    return True
 
 
 def wait_for_ray_head(address: str, deadline: float, timeout_s: float) -> None:
@@ -45,21 +74,41 @@ def wait_for_ray_head(address: str, deadline: float, timeout_s: float) -> None:
         time.sleep(0.5)
 
 
-def bounded_call(call: Callable[[], object], deadline: float) -> None:
-    """Run `call` on a thread; TimeoutError when it has not returned by `deadline` (the thread
-    is left behind: the process is about to report and exit)."""
-    failure: list[BaseException] = []
+class KeeperThread:
+    """Runs `call` on a thread that stays alive, after the call returns, until `release()`.
 
-    def target() -> None:
+    `start(deadline)` raises TimeoutError when `call` has not returned by `deadline` (the thread
+    is left behind: the process is about to report and exit) and re-raises what `call` raised.
+    Processes `call` starts with a parent-death signal live as long as the thread (see the
+    module's docstring).
+    """
+
+    def __init__(self, call: Callable[[], object], name: str = "ray-init") -> None:
+        self._call = call
+        self._returned = threading.Event()
+        self._released = threading.Event()
+        self._failure: list[BaseException] = []
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+
+    def _run(self) -> None:
         try:
-            call()
+            self._call()
         except BaseException as exc:
-            failure.append(exc)
+            self._failure.append(exc)
+            self._released.set()
+        finally:
+            self._returned.set()
+        self._released.wait()
 
-    thread = threading.Thread(target=target, name="ray-init", daemon=True)
-    thread.start()
-    thread.join(max(0.0, deadline - time.monotonic()))
-    if thread.is_alive():
-        raise TimeoutError
-    if failure:
-        raise failure[0]
+    def start(self, deadline: float) -> KeeperThread:
+        self._thread.start()
+        if not self._returned.wait(max(0.0, deadline - time.monotonic())):
+            raise TimeoutError
+        if self._failure:
+            raise self._failure[0]
+        return self
+
+    def release(self) -> None:
+        """Let the thread end (after the caller has shut down what `call` started)."""
+        self._released.set()
+        self._thread.join(timeout=5.0)

@@ -128,8 +128,11 @@ def _plots(ok: Sequence[DriveResult], drivers: Sequence[GroupStats]) -> str:
         axes.yaxis.get_major_locator().set_params(integer=True)
         axes.set_title("Longest off-road episode per drive")
 
-    height = max(2.5, 0.28 * len(shown) + 1.2)
-    bars = _png(lambda axes: alerts_by_driver(axes, shown), (9.0, height))
+    if any(rate for d in shown for rate in d.alerts_per_h.values()):
+        height = max(2.5, 0.28 * len(shown) + 1.2)
+        bars = _png(lambda axes: alerts_by_driver(axes, shown), (9.0, height))
+    else:
+        bars = '<p class="note">No drive raised an alert, so there are no alert rates to plot.</p>'
     return bars + _png(off_road) + _png(longest)
 
 

@@ -1,17 +1,31 @@
-"""A progress bar on stderr as a pipeline sink."""
+"""Progress bars on stderr: the one way roadgaze draws them, and the pipeline sink."""
 
 from __future__ import annotations
+
+from typing import Any
 
 from roadgaze.types import ClosesOnExit, Frame, FrameRecord
 
 
+def terminal_bar(total: int | None, description: str, unit: str, enabled: bool = True) -> Any:
+    """A tqdm bar on stderr, drawn only where stderr is a terminal: redirected to a file or a
+    pipe it stays off (its carriage-return frames would fill the log), as with `enabled` False."""
+    from tqdm import tqdm
+
+    return tqdm(
+        total=total,
+        desc=description,
+        unit=unit,
+        dynamic_ncols=True,
+        disable=None if enabled else True,  # None: tqdm's own "off unless a terminal"
+    )
+
+
 class ProgressBar(ClosesOnExit):
-    """A tqdm progress bar on stderr (frames, fps, ETA) as a sink."""
+    """A progress bar (frames, fps, ETA) as a sink; see `terminal_bar`."""
 
     def __init__(self, total: int | None, description: str = "replay") -> None:
-        from tqdm import tqdm
-
-        self._bar = tqdm(total=total, desc=description, unit="frame", dynamic_ncols=True)
+        self._bar = terminal_bar(total, description, "frame")
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         self._bar.update(1)

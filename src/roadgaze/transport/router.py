@@ -201,10 +201,15 @@ refused handshake (a plain TCP client, no or a foreign certificate). `RUST_LOG` 
 
 
 def log_refused_handshakes() -> None:
-    """Turn on Zenoh's own log (stderr, Zenoh's format) for refused TLS handshakes: Zenoh opens
-    no transport for them, so the transport events never see them. Once per process."""
+    """Turn on Zenoh's own log for refused TLS handshakes (Zenoh opens no transport for them, so
+    the transport events never see them), relayed to stderr through roadgaze's log
+    (`roadgaze.transport.zenoh_log`: Zenoh itself writes to stdout, in colour). Once per
+    process."""
     import zenoh
 
+    from roadgaze.transport.zenoh_log import relay_zenoh_log
+
+    relay_zenoh_log()
     try:
         zenoh.init_log_from_env_or(ZENOH_LOG)
     except Exception as exc:  # already initialised in this process

@@ -30,6 +30,8 @@ PURE_MODULES = (
     "roadgaze.transport.vss",
     "roadgaze.landmarks.features",
     "roadgaze.landmarks.driver",
+    "roadgaze.landmarks.driver_track",
+    "roadgaze.landmarks.seat",
     "roadgaze.landmarks.eyes",
     "roadgaze.config",
     "roadgaze.eye_records",

@@ -76,7 +76,7 @@ def test_each_channel_has_its_well_known_or_own_schema(
         TOPIC_RECORD: "roadgaze.record",
         TOPIC_LIMITS: "roadgaze.limits",
         TOPIC_ALERTS: "roadgaze.alert/3",
-        TOPIC_STATE: "roadgaze.state/4",
+        TOPIC_STATE: "roadgaze.state/5",
     }
     assert contents.encodings[TOPIC_IMAGE] == ("protobuf", "protobuf")
     assert contents.encodings[TOPIC_RECORD] == ("jsonschema", "json")

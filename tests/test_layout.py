@@ -32,6 +32,7 @@ PURE_MODULES = (
     "roadgaze.landmarks.driver",
     "roadgaze.landmarks.driver_track",
     "roadgaze.landmarks.seat",
+    "roadgaze.capture.mcap_driver",
     "roadgaze.landmarks.eyes",
     "roadgaze.config",
     "roadgaze.eye_records",

@@ -33,6 +33,15 @@ FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True, slots=True)
+class RecordedDriver:
+    """The driver a recording chose on one of its frames (`roadgaze.capture.mcap`)."""
+
+    box_px: tuple[float, float, float, float] | None
+    """The driver's face box in the pixels of the recorded image (x_min, y_min, x_max, y_max);
+    None: the recording had no driver on this frame."""
+
+
+@dataclass(frozen=True, slots=True)
 class Frame:
     """One image from a frame source."""
 
@@ -42,6 +51,8 @@ class Frame:
     """Seconds on the source timeline; strictly increasing within one source."""
     image: npt.NDArray[np.uint8]
     """BGR, uint8, shape (height, width, 3)."""
+    recorded_driver: RecordedDriver | None = None
+    """A recording's frame: the driver it chose, followed on replay; None: choose afresh."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -93,7 +104,10 @@ class Detection:
 
     faces: tuple[FaceFeatures, ...]
     driver_index: int | None
-    """Index into `faces` of the driver, None when no face was found."""
+    """Index into `faces` of the driver, None when no face was found (or none is the driver)."""
+    driver_ambiguous: str = ""
+    """Why the driver cannot be told from another face in view ('' when it can:
+    `roadgaze.landmarks.seat.ambiguity`)."""
 
     @property
     def driver(self) -> FaceFeatures | None:
@@ -150,6 +164,8 @@ class PoseSample:
     """The driver's eyes (roadgaze.landmarks.eyes); None without a face or eye measurement."""
     frame_check: FrameCheck | None = None
     """The image's cheap checks (dark, flat, saturated, repeated); None when not measured."""
+    driver_ambiguous: str = ""
+    """Why the driver cannot be told from another face in view ('' when it can)."""
 
 
 class AlertKind(StrEnum):

@@ -29,7 +29,7 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
     assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
     assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/3"
-    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/4"
+    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/5"
     snapshot = schemas["state"]["$defs"]["MonitorSnapshot"]
     assert {"zone", "neutral_pitch_deg", "pitch_deg"} <= set(snapshot["required"])
     # yaw/3 and state/3 add the eyes; alert/2 the closure and drowsiness kinds
@@ -48,6 +48,8 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     assert {"protocol", "distraction_warn_s", "distraction_rule", "failure"} <= set(
         snapshot["required"]
     )
+    # state/5: why the driver cannot be told from another face
+    assert "driver_ambiguous" in schemas["state"]["required"]
     assert "permanent_failure" in schemas["state"]["required"]
 
 

@@ -11,7 +11,7 @@ import numpy.typing as npt
 import pytest
 from skimage import data as skimage_data
 
-from roadgaze.config import LandmarksConfig, load_config
+from roadgaze.config import Config, LandmarksConfig, MonitorConfig, load_config
 from roadgaze.landmarks import MediaPipeLandmarker
 from roadgaze.landmarks.model_store import resolve_model
 from roadgaze.landmarks.multi_face import (
@@ -21,6 +21,7 @@ from roadgaze.landmarks.multi_face import (
     MultiFaceSwitch,
     detector_model_bytes,
 )
+from roadgaze.types import RecordedDriver
 
 BOX = (100.0, 100.0, 200.0, 220.0)
 MOVED = (300.0, 100.0, 400.0, 220.0)
@@ -176,3 +177,51 @@ def test_a_periodic_count_is_taken_at_the_next_frame_even_when_it_is_slow() -> N
     finally:
         background.close()
     assert len(threads) == 1 and threads[0].startswith("roadgaze-facecount")
+
+
+def pair() -> npt.NDArray[np.uint8]:
+    """Two people side by side: the astronaut on the image's left, a copy 0.85 times her size
+    on the right."""
+    face = cv2.cvtColor(skimage_data.astronaut()[20:260, 120:340], cv2.COLOR_RGB2BGR)
+    canvas = np.full((260, 460, 3), 255, np.uint8)
+    canvas[10:250, 0:220] = face
+    canvas[28:232, 250:437] = cv2.resize(face, (187, 204))
+    return canvas
+
+
+@pytest.mark.parametrize(("cabin", "right"), [("lhd", True), ("rhd", False)])
+def test_the_driver_is_the_face_in_the_drivers_seat_not_the_largest(
+    model_path: Path, cabin: str, right: bool
+) -> None:
+    """Left-hand drive, camera in front: the driver is on the image's right although the face on
+    the left is larger (the "largest" rule took the left one); right-hand drive: the left."""
+    config = Config(monitor=MonitorConfig(cabin=cabin))  # type: ignore[arg-type]
+    image = pair()
+    with MediaPipeLandmarker.from_config(config, video=True) as detector:
+        chosen = [detector.detect(image, index / 10).driver for index in range(10)]
+    with MediaPipeLandmarker.from_config(config) as still:
+        detection = still.detect(image)
+    assert len(detection.faces) == 2 and detection.driver_ambiguous == ""
+    for driver in [*chosen, detection.driver]:
+        assert driver is not None and (driver.box_px[0] > 230) is right
+
+
+def test_a_recordings_driver_is_found_even_where_one_face_is_tracked(model_path: Path) -> None:
+    """One face for 0.5 s (the one-face landmarker tracks it), then a second appears beside it:
+    with a recording that chose the newcomer, that very frame is counted again and its driver
+    is the newcomer, although the periodic count is 10 s away."""
+    config = LandmarksConfig(multi_face_check_s=10.0)
+    one, two = scene(False), pair()
+    with MediaPipeLandmarker(config, model_path) as still:
+        newcomer = max(still.detect(two).faces, key=lambda face: face.box_px[0]).box_px
+    with MediaPipeLandmarker(config, model_path, video=True) as detector:
+        for index in range(5):
+            assert detector.detect(one, index / 10).driver is not None
+        detector.follow(RecordedDriver(newcomer))
+        followed = detector.detect(two, 0.5)
+        mode = detector.face_mode
+        detector.follow(None)
+        held = detector.detect(two, 0.6)
+    assert mode is FaceMode.MULTI and len(followed.faces) == 2
+    for detection in (followed, held):
+        assert detection.driver is not None and detection.driver.box_px[0] > 230

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import logging
 from collections.abc import Iterator
+from dataclasses import replace
 
 import jsonschema
 import pytest
@@ -116,6 +117,23 @@ def test_state_is_degraded_when_the_camera_or_zenoh_is_lost() -> None:
     health.source = None
     link.connected = False
     assert health.state_message().problems == ["zenoh not connected"]
+
+
+def test_state_says_when_the_driver_cannot_be_told_from_another_face() -> None:
+    config = Config()
+    health = Health(config, Keys.from_config(config.zenoh), FakeLink(), "drive.mp4")
+    reason = "another face of similar size sits at the driver's place in the image"
+    first, second = records(config, [(0.0, 0.0), (0.1, 0.0)])
+    health.on_record(
+        replace(first, sample=replace(first.sample, driver_ambiguous=reason)), BLANK_FRAME
+    )
+    state = health.state_message()
+    assert (state.status, state.driver_ambiguous) == ("degraded", reason)
+    assert state.problems == [f"driver ambiguous: {reason}"]
+    jsonschema.validate(json.loads(state.to_json_bytes()), SCHEMAS["state"])
+    health.on_record(second, BLANK_FRAME)
+    state = health.state_message()
+    assert (state.status, state.driver_ambiguous, state.problems) == ("running", "", [])
 
 
 def test_state_is_degraded_while_the_eyes_have_been_unavailable_ten_seconds() -> None:

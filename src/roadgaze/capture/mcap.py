@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from roadgaze.capture.base import SourceBase, SourceInfo, SourceStatus
+from roadgaze.capture.mcap_driver import DRIVER_TOPIC, RecordedDrivers
 from roadgaze.capture.mcap_images import IMAGE_SCHEMAS, CameraImage, ImageDecoder
 from roadgaze.errors import SourceError
 from roadgaze.types import Frame
@@ -61,6 +62,7 @@ class McapSource(SourceBase):
         self._requested_topic = topic
         self._status = SourceStatus()
         self._truncation: str | None = None
+        self._drivers = RecordedDrivers()  # the driver recorded with each frame (mcap_driver)
         try:
             self._handle: IO[bytes] | None = self.path.open("rb")
         except OSError as exc:
@@ -143,6 +145,7 @@ class McapSource(SourceBase):
         assert self._handle is not None
         schemas: dict[int, Any] = {}
         decoders: dict[int, ImageDecoder] = {}
+        driver_channels: set[int] = set()
         reader = StreamReader(self._handle, skip_magic=False)
         records = iter(reader.records)
         while True:
@@ -163,9 +166,13 @@ class McapSource(SourceBase):
             elif isinstance(record, Metadata) and self.offset_ns is None:
                 self.offset_ns = _offset_ns([record])
             elif isinstance(record, Channel):
+                if record.topic == DRIVER_TOPIC:
+                    driver_channels.add(record.id)
                 decoder = self._decoder_of(record, schemas.get(record.schema_id))
                 if decoder is not None:
                     decoders[record.id] = decoder
+            elif isinstance(record, Message) and record.channel_id in driver_channels:
+                self._drivers.note(record.log_time, record.data)
             elif isinstance(record, Message) and record.channel_id in decoders:
                 decoded = self._decode(decoders[record.channel_id], record)
                 if decoded is not None:
@@ -228,7 +235,7 @@ class McapSource(SourceBase):
             if previous_t_s is not None and t_s <= previous_t_s:
                 t_s = previous_t_s + period_s
             self._status = replace(self._status, frames_delivered=index + 1)
-            yield Frame(index=index, t_s=t_s, image=camera.image)
+            yield Frame(index, t_s, camera.image, self._drivers.take(log_ns))
             previous_t_s = t_s
             index += 1
             item = next(self._frames, None)

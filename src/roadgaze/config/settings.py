@@ -95,8 +95,10 @@ class LandmarksConfig(_Section):
     min_detection_confidence: float = Field(default=0.5, ge=0, le=1)
     min_presence_confidence: float = Field(default=0.5, ge=0, le=1)
     min_tracking_confidence: float = Field(default=0.5, ge=0, le=1)
-    driver: Literal["largest", "left", "right"] = "largest"
-    """Which face is the driver: the largest, or the one on the image's left or right side."""
+    driver: Literal["seat", "largest", "left", "right"] = "seat"
+    """Which face is the driver: `seat`, the face in the driver's seat for `[monitor] cabin` and
+    the camera mounting, then held by identity (docs/landmarks.md); or, frame by frame, the
+    largest, or the one on the image's left or right side."""
     multi_face_check_s: float = Field(default=1.0, ge=0)
     """In a stream, how often the one-face landmarker is checked for further faces (seconds);
     0 runs the `max_faces` landmarker on every frame (slower: its face detector then runs on every

@@ -3,52 +3,61 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Protocol
 
 import numpy as np
 
 from roadgaze.landmarks.eyes import swap_sides
+from roadgaze.landmarks.seat import (
+    DRIVER_SWITCH_AREA_RATIO,
+    Box,
+    Boxed,
+    area,
+    centre_x,
+    seat_pick,
+)
 from roadgaze.types import FaceFeatures
 
-DRIVER_SWITCH_AREA_RATIO = 1.25
-"""In a stream, the "largest" rule moves to another face only when that face's box is this much
-larger than the current driver's; faces of similar size would otherwise swap from frame to frame."""
+__all__ = [
+    "DRIVER_MATCH_IOU",
+    "DRIVER_RULES",
+    "DRIVER_SWITCH_AREA_RATIO",
+    "Box",
+    "Boxed",
+    "box_iou",
+    "choose_driver",
+    "merge_mirrored",
+    "rule_side",
+    "unmirror",
+]
+
 DRIVER_MATCH_IOU = 0.3
 """Box overlap above which a face in a new frame is taken to be the previous frame's driver."""
-
-
-Box = tuple[float, float, float, float]
-
-
-class Boxed(Protocol):
-    """A face with its bounding box: `FaceFeatures`, or a face found but not yet measured."""
-
-    @property
-    def box_px(self) -> Box: ...
-
-
-def _area(face: Boxed) -> float:
-    return (face.box_px[2] - face.box_px[0]) * (face.box_px[3] - face.box_px[1])
+DRIVER_RULES = ("seat", "largest", "left", "right")
+"""The values of `landmarks.driver` (docs/landmarks.md, "Which face is the driver")."""
 
 
 def choose_driver(
     faces: Sequence[Boxed],
     rule: str,
     previous_box_px: Box | None = None,
+    side: int = 1,
 ) -> int | None:
     """Index of the driver among `faces` under `rule`, None when there is no face.
 
-    "largest": the face with the largest bounding-box area (default; the driver sits nearest the
-    camera). "left" / "right": the face whose box centre is furthest to the image's left / right,
-    i.e. the driver sits on that side of the picture as the camera sees it (for a camera facing a
-    left-hand-drive driver from the dashboard centre, the driver appears on the image's right).
-    `previous_box_px` (streams): the previous frame's driver box; under "largest" that face stays
-    the driver unless another is `DRIVER_SWITCH_AREA_RATIO` times larger.
+    "seat" (default): the face in the driver's seat, `side` +1 (image right) or -1 (left) as
+    `roadgaze.landmarks.seat.driver_image_side` gives it for the cabin and camera mounting, 0
+    unknown (`seat_pick`: the larger face then); a stream holds that face by identity
+    (`roadgaze.landmarks.driver_track`). "largest": the face with the largest bounding-box
+    area. "left" / "right": the face whose box centre is furthest to the image's left / right.
+    `previous_box_px` (streams, "largest" only): the previous frame's driver box; that face
+    stays the driver unless another is `DRIVER_SWITCH_AREA_RATIO` times larger.
     """
     if not faces:
         return None
+    if rule == "seat":
+        return seat_pick(faces, side)
     if rule == "largest":
-        areas = [_area(f) for f in faces]
+        areas = [area(f.box_px) for f in faces]
         best = int(np.argmax(areas))
         if previous_box_px is not None:
             overlaps = [box_iou(f.box_px, previous_box_px) for f in faces]
@@ -59,12 +68,17 @@ def choose_driver(
             ):
                 return kept
         return best
-    centers = [0.5 * (f.box_px[0] + f.box_px[2]) for f in faces]
+    centers = [centre_x(f.box_px) for f in faces]
     if rule == "left":
         return int(np.argmin(centers))
     if rule == "right":
         return int(np.argmax(centers))
-    raise ValueError(f"unknown driver rule '{rule}'; choose largest, left or right")
+    raise ValueError(f"unknown driver rule '{rule}'; choose {', '.join(DRIVER_RULES)}")
+
+
+def rule_side(rule: str, seat_side: int) -> int:
+    """The image side the driver is looked for on under `rule` (0: by size, or unknown)."""
+    return {"seat": seat_side, "left": -1, "right": 1}.get(rule, 0)
 
 
 def box_iou(a: Box, b: Box) -> float:

@@ -3,11 +3,11 @@
 Its models run on the engine `landmarks.engine` chooses (`roadgaze.landmarks.engines`: LiteRT, or
 MediaPipe's FaceLandmarker; `MediaPipeLandmarker` always runs MediaPipe's). It measures every face
 with `features_from_landmarks` and chooses the driver among several faces by
-`LandmarksConfig.driver` (see `roadgaze.landmarks.driver`). The work of one frame comes in three
-steps so that a stream can run them on three threads (`roadgaze.pipeline`): `prepare` (the image
-for the engine; no state), `infer` (the engine itself, the frames in order; in VIDEO mode also the
-driver's choice, which the next frame's tracking needs) and `measure` (the features of each face;
-no state). `detect` is the three in a row.
+`LandmarksConfig.driver` (see `roadgaze.landmarks.driver_track`). The work of one frame comes in
+three steps so that a stream can run them on three threads (`roadgaze.pipeline`): `prepare` (the
+image for the engine; no state), `infer` (the engine itself, the frames in order; in VIDEO mode
+also the driver's choice, which the next frame's tracking needs) and `measure` (the features of
+each face; no state). `detect` is the three in a row.
 """
 
 from __future__ import annotations
@@ -23,7 +23,8 @@ import numpy as np
 import numpy.typing as npt
 
 from roadgaze.config import Config, LandmarksConfig
-from roadgaze.landmarks.driver import choose_driver, merge_mirrored
+from roadgaze.landmarks.driver import box_iou, choose_driver, merge_mirrored, rule_side
+from roadgaze.landmarks.driver_track import DriverTracker
 from roadgaze.landmarks.engines import FaceCounting, FaceRunner, Tracking, open_engine
 from roadgaze.landmarks.eye_contrast import eye_checks
 from roadgaze.landmarks.eyes import LEFT_EYE, RIGHT_EYE
@@ -37,36 +38,11 @@ from roadgaze.landmarks.features import (
 from roadgaze.landmarks.multi_face import BackgroundCount, FaceMode, MultiFaceSwitch
 from roadgaze.landmarks.native_log import filtered_native_stderr
 from roadgaze.landmarks.results import Blendshapes, FaceArrays
-from roadgaze.types import ClosesOnExit, Detection, FaceFeatures
+from roadgaze.landmarks.rgb import rgb_to_gray, to_rgb
+from roadgaze.landmarks.seat import ambiguity, driver_image_side
+from roadgaze.types import ClosesOnExit, Detection, FaceFeatures, RecordedDriver
 
-
-def to_rgb(image: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
-    """A contiguous RGB uint8 copy of a BGR, BGRA or grayscale image; ValueError otherwise."""
-    import cv2
-
-    array = np.asarray(image)
-    if array.dtype != np.uint8:
-        raise ValueError(f"expected a uint8 image, found dtype {array.dtype}")
-    if array.ndim == 3 and array.shape[2] == 1:
-        array = array[:, :, 0]
-    if array.ndim in (2, 3) and (array.shape[0] < 1 or array.shape[1] < 1):
-        raise ValueError(f"empty image of shape {array.shape}")
-    if array.ndim == 2:
-        rgb = cv2.cvtColor(array, cv2.COLOR_GRAY2RGB)
-    elif array.ndim == 3 and array.shape[2] == 3:
-        rgb = cv2.cvtColor(array, cv2.COLOR_BGR2RGB)
-    elif array.ndim == 3 and array.shape[2] == 4:
-        rgb = cv2.cvtColor(array, cv2.COLOR_BGRA2RGB)
-    else:
-        raise ValueError(f"expected a grayscale, BGR or BGRA image, found shape {array.shape}")
-    return np.ascontiguousarray(rgb)
-
-
-def rgb_to_gray(rgb: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
-    """The grey image the eye check measures (OpenCV's luma weights)."""
-    import cv2
-
-    return np.asarray(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY), dtype=np.uint8)
+__all__ = ["Inference", "Landmarker", "MediaPipeLandmarker", "PreparedImage", "to_rgb"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -114,6 +90,8 @@ class Inference:
     """VIDEO mode: the driver among `faces` (None: no face). IMAGE mode: None, `measure` chooses."""
     mirrored: tuple[FoundFace, ...] = ()
     """`mirror_average`: the faces found in the horizontally flipped image."""
+    driver_ambiguous: str = ""
+    """VIDEO mode: why the driver cannot be told from another face ('' when it can)."""
 
 
 class Landmarker(ClosesOnExit):
@@ -125,8 +103,10 @@ class Landmarker(ClosesOnExit):
     A stream runs a one-face landmarker and switches to the `max_faces` one only while a face
     count sees several faces (`roadgaze.landmarks.multi_face`); with
     `landmarks.multi_face_check_s = 0`, `max_faces = 1` or `mirror_average` every frame runs one
-    landmarker with `max_faces` faces. `engine` overrides `landmarks.engine`. Raises ModelError
-    (one line) for a model that cannot be loaded.
+    landmarker with `max_faces` faces. `engine` overrides `landmarks.engine`. `seat_side`: where
+    the driver sits in the image, +1 right, -1 left, 0 unknown (`driver_image_side`; `from_config`
+    takes it from `[monitor] cabin` and the camera mounting; +1, a left-hand-drive car's, by
+    default). Raises ModelError (one line) for a model that cannot be loaded.
     """
 
     engine_override: ClassVar[str | None] = None
@@ -139,6 +119,7 @@ class Landmarker(ClosesOnExit):
         video: bool = False,
         choice: LandmarkChoice = DEFAULT_CHOICE,
         engine: str | None = None,
+        seat_side: int = 1,
     ) -> None:
         from roadgaze.errors import ModelError
 
@@ -147,7 +128,9 @@ class Landmarker(ClosesOnExit):
         self._choice = choice
         self._last_ms = -1
         self._last_t_s = -math.inf
-        self._driver_box_px: Box | None = None
+        self._side = rule_side(landmarks_config.driver, seat_side)
+        self._tracker = DriverTracker(landmarks_config.driver, seat_side)
+        self._recorded: RecordedDriver | None = None
         self._landmarker: FaceRunner | None = None
         self._mirror_landmarker: FaceRunner | None = None
         self._single_landmarker: FaceRunner | None = None
@@ -190,7 +173,10 @@ class Landmarker(ClosesOnExit):
         """A landmarker with the model from `resolve_model` (fetched on first use if allowed)."""
         from roadgaze.landmarks.model_store import resolve_model
 
-        return cls(config.landmarks, resolve_model(config.model), video=video)
+        mounting = config.monitor.mounting()
+        angles = (mounting.yaw_deg, mounting.pitch_deg, mounting.roll_deg)
+        side = driver_image_side(config.monitor.cabin, *angles)
+        return cls(config.landmarks, resolve_model(config.model), video=video, seat_side=side)
 
     @property
     def video(self) -> bool:
@@ -260,11 +246,18 @@ class Landmarker(ClosesOnExit):
             return Inference(prepared.gray, tuple(faces), None, tuple(mirrored))
         # Chosen on the faces of the original image (with `mirror_average` their merged
         # measurements keep these indices).
-        driver_index = choose_driver(faces, self._config.driver, self._driver_box_px)
-        self._driver_box_px = None if driver_index is None else faces[driver_index].box_px
+        tracker = self._tracker
+        driver_index = tracker.step(faces, t_s or 0.0, self._recorded)
         if self._switch is not None and self._switch.mode is FaceMode.MULTI:
-            self._switch.seen(t_s or 0.0, len(faces), self._driver_box_px)
-        return Inference(prepared.gray, tuple(faces), driver_index, tuple(mirrored))
+            self._switch.seen(t_s or 0.0, len(faces), tracker.box_px)
+        return Inference(
+            prepared.gray, tuple(faces), driver_index, tuple(mirrored), tracker.ambiguous
+        )
+
+    def follow(self, recorded: RecordedDriver | None) -> None:
+        """The driver a recording chose on the frame `infer` takes next (None: choose afresh);
+        the loop calls it before each frame of a recording."""
+        self._recorded = recorded
 
     def measure(self, inference: Inference) -> Detection:
         """The features of each face `infer` found (roll removed, eyes, quality) and the driver.
@@ -277,8 +270,10 @@ class Landmarker(ClosesOnExit):
             mirrored = self._features(inference.mirrored, np.ascontiguousarray(gray[:, ::-1]))
             faces = merge_mirrored(faces, mirrored, gray.shape[1])
         if not self._video:
-            return Detection(tuple(faces), choose_driver(faces, self._config.driver))
-        return Detection(faces=tuple(faces), driver_index=inference.driver_index)
+            rule = self._config.driver
+            index = choose_driver(faces, rule, side=self._side)
+            return Detection(tuple(faces), index, ambiguity(faces, index, rule, self._side))
+        return Detection(tuple(faces), inference.driver_index, inference.driver_ambiguous)
 
     def _run_switching(
         self, mp_image: Any, size: tuple[int, int], t_s: float, timestamp_ms: int | None
@@ -302,13 +297,18 @@ class Landmarker(ClosesOnExit):
                 # multi-face landmarker, which detects on every frame, would have.
                 faces = self._find(self._single_landmarker, mp_image, size, self._next_ms())
             box = faces[0].box_px if faces else None
-            if not switch.jumped(t_s, box):
+            if not switch.jumped(t_s, box) and not self._elsewhere(box):
                 return faces
             switch.counted(t_s, counter.count(mp_image))
             if not switch.multi:
                 return faces
             return self._find(self._landmarker, mp_image, size, self._next_ms())
         return self._find(self._landmarker, mp_image, size, timestamp_ms)
+
+    def _elsewhere(self, box: Box | None) -> bool:
+        """The one face found is not the driver a recording chose on this frame: count now."""
+        recorded = None if self._recorded is None else self._recorded.box_px
+        return recorded is not None and (box is None or box_iou(box, recorded) < 0.3)
 
     def _next_ms(self) -> int:
         """A further MediaPipe timestamp within the current frame (a second call on it)."""

@@ -37,6 +37,7 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("frame", FieldType.INT),
     ("face", FieldType.BOOL),
     ("n_faces", FieldType.INT),
+    ("driver_ambiguous", FieldType.STR),
     ("yaw_raw_deg", FieldType.FLOAT),
     ("yaw_deg", FieldType.FLOAT),
     ("yaw_rate_dps", FieldType.FLOAT),
@@ -77,7 +78,8 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("pitch_offline_deg", FieldType.FLOAT),
 )
 """Every field of `record_fields`, in order, with its type: the one description the writers and
-the fleet's Parquet schema are derived from (x_* in pixels of the roll-removed frame; the eye
+the fleet's Parquet schema are derived from (x_* in pixels of the roll-removed frame;
+`driver_ambiguous` why the driver cannot be told from another face in view, '' when it can; the eye
 fields as `roadgaze.types.EyesVerdict` defines them, `eyes` is open, closed or unavailable). A
 field added to `record_fields` is added here too (a test checks it)."""
 
@@ -123,6 +125,7 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "frame": sample.frame,
         "face": sample.face,
         "n_faces": sample.n_faces,
+        "driver_ambiguous": sample.driver_ambiguous,
         "yaw_raw_deg": rounded(sample.yaw_raw_deg, 3),
         "yaw_deg": rounded(sample.yaw_deg, 3),
         "yaw_rate_dps": rounded(sample.yaw_rate_dps, 3),

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from roadgaze.capture import FrameSource
-from roadgaze.types import Detection, Frame, LandmarkDetector
+from roadgaze.types import Detection, Frame, LandmarkDetector, RecordedDriver
 
 log = logging.getLogger(__name__)
 
@@ -73,15 +73,18 @@ class DetectorSteps:
     prepare: Callable[[Any], Any] | None
     infer: Callable[[Any, float | None], Any]
     measure: Callable[[Any], Detection]
+    follow: Callable[[RecordedDriver | None], None] | None = None
+    """The detector's `follow`: told, before each frame, the driver a recording chose on it."""
 
     @classmethod
     def of(cls, detector: LandmarkDetector) -> DetectorSteps:
         prepare = getattr(detector, "prepare", None)
         infer = getattr(detector, "infer", None)
         measure = getattr(detector, "measure", None)
+        follow = getattr(detector, "follow", None)
         if prepare is not None and infer is not None and measure is not None:
-            return cls(prepare, infer, measure)
-        return cls(None, detector.detect, _already_measured)
+            return cls(prepare, infer, measure, follow)
+        return cls(None, detector.detect, _already_measured, follow)
 
     def input_of(self, frame: Frame, prepared: Any) -> Any:
         """What `infer` takes for `frame`: its image prepared (here if not beforehand) or as is."""
@@ -143,6 +146,8 @@ def infer_one(
     """`frame` (with its image `prepared`, or None) through the detector's `infer`, timed from
     now: the start of its latency."""
     received_s = clock()
+    if steps.follow is not None:
+        steps.follow(frame.recorded_driver)
     inference = steps.infer(steps.input_of(frame, prepared), frame.t_s)
     here = prepared is None and steps.prepare is not None
     return Inferred(frame, inference, decode_ms, received_s, clock(), here)

@@ -141,6 +141,7 @@ class PoseEstimator:
             yaw_std_deg=None if yaw is None else yaw.std_deg,
             features=features,
             n_faces=len(detection.faces),
+            driver_ambiguous=detection.driver_ambiguous,
             pitch_raw_deg=pitch_raw_deg,
             pitch_deg=None if pitch is None else pitch.angle_deg,
             roll_deg=None if features is None else features.roll_deg,

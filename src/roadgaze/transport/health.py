@@ -135,6 +135,9 @@ class Health:
             problems.append(f"temporary failure: {verdict.failure}")  # (the eyes: said above)
         if self.permanent_failure:
             problems.append(f"permanent failure: {self.permanent_failure}")
+        ambiguous = "" if record is None else record.sample.driver_ambiguous
+        if ambiguous:
+            problems.append(f"driver ambiguous: {ambiguous}")
         problems.extend(problem for check in self.problem_checks if (problem := check()))
         status = self.status
         if status in ("starting", "running") and problems:
@@ -151,6 +154,7 @@ class Health:
             source_status=source_status,
             frames=self.frames,
             faces=self.faces,
+            driver_ambiguous=ambiguous,
             camera_reopens=camera_reopens,
             permanent_failure=self.permanent_failure,
             transport=transport,

@@ -25,7 +25,7 @@ from roadgaze.types import (
 
 YAW_SCHEMA = "roadgaze.yaw/3"
 ALERT_SCHEMA = "roadgaze.alert/3"
-STATE_SCHEMA = "roadgaze.state/4"
+STATE_SCHEMA = "roadgaze.state/5"
 
 
 class _Message(BaseModel):
@@ -333,12 +333,12 @@ class StateMessage(_Message):
     distraction timer and the time and rule that warn at the current speed, and the temporary
     failure in force, and the eye calibration (`eye_calibration`); `permanent_failure` (the
     camera gone past `permanent_failure_s`); and `alerts_waiting`, `alerts_lost` and
-    `undelivered_alerts` to `transport` (the alert ledger). The monitor's angles are in the
-    driver's frame (the camera mounting applied). Every earlier field keeps its name and
-    meaning.
+    `undelivered_alerts` to `transport` (the alert ledger). `roadgaze.state/5` adds
+    `driver_ambiguous`. The monitor's angles are in the driver's frame (the camera mounting
+    applied). Every earlier field keeps its name and meaning.
     """
 
-    schema_id: Literal["roadgaze.state/4"] = Field(default="roadgaze.state/4", alias="schema")
+    schema_id: Literal["roadgaze.state/5"] = Field(default="roadgaze.state/5", alias="schema")
     vehicle_id: str
     wall_time: float
     status: Literal["starting", "running", "degraded", "stopping", "stopped"]
@@ -349,6 +349,11 @@ class StateMessage(_Message):
     source_status: str
     frames: int
     faces: int
+    driver_ambiguous: str = Field(
+        default="",
+        description="roadgaze.state/5: why the driver cannot be told from another face in view "
+        "on the last frame ('' when it can: docs/landmarks.md); also among `problems`.",
+    )
     camera_reopens: int = 0
     permanent_failure: str = Field(
         default="", description="The permanent failure in force ('' for none), with its reason."

@@ -85,8 +85,9 @@ def test_a_client_is_told_every_channel_subscribes_and_receives_records_and_imag
             "/roadgaze/record": "roadgaze.record",
             "/roadgaze/limits": "roadgaze.limits",
             "/roadgaze/alerts": "roadgaze.alert/3",
-            "/roadgaze/state": "roadgaze.state/4",
+            "/roadgaze/state": "roadgaze.state/5",
             "/roadgaze/log": "foxglove.Log",
+            "/roadgaze/driver": "roadgaze.driver/1",
         }
         assert channels[TOPIC_RECORD]["encoding"] == "json"
         assert json.loads(channels[TOPIC_RECORD]["schema"])["title"] == "roadgaze.record"

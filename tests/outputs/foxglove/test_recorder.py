@@ -24,6 +24,7 @@ from roadgaze.outputs.foxglove import recorder as recorder_module
 from roadgaze.outputs.foxglove.channels import (
     TOPIC_ALERTS,
     TOPIC_ANNOTATIONS,
+    TOPIC_DRIVER,
     TOPIC_IMAGE,
     TOPIC_LIMITS,
     TOPIC_LOG,
@@ -76,7 +77,8 @@ def test_each_channel_has_its_well_known_or_own_schema(
         TOPIC_RECORD: "roadgaze.record",
         TOPIC_LIMITS: "roadgaze.limits",
         TOPIC_ALERTS: "roadgaze.alert/3",
-        TOPIC_STATE: "roadgaze.state/4",
+        TOPIC_STATE: "roadgaze.state/5",
+        TOPIC_DRIVER: "roadgaze.driver/1",
     }
     assert contents.encodings[TOPIC_IMAGE] == ("protobuf", "protobuf")
     assert contents.encodings[TOPIC_RECORD] == ("jsonschema", "json")

@@ -8,7 +8,9 @@ frame record (`record_fields`, every frame; its schema derived from `RECORD_SCHE
 field flows in without a change here), the monitor's limits (the road zone around the learned
 neutral, the timers' thresholds; when the neutral moves, and at least every state interval),
 the alerts and the state (the messages `roadgaze schema` prints, named by their version, so a
-new alert kind or field flows in too). Every message is stamped with its frame's capture time
+new alert kind or field flows in too), and the driver chosen on each recorded camera frame
+(`/roadgaze/driver`, `roadgaze.capture.mcap_driver`: a replay of the recording follows it). Every
+message is stamped with its frame's capture time
 (`log_time` = `publish_time`, and the header stamps).
 """
 
@@ -34,6 +36,12 @@ from foxglove.messages import (
     Timestamp,
 )
 
+from roadgaze.capture.mcap_driver import (
+    DRIVER_SCHEMA_NAME,
+    DRIVER_TOPIC,
+    driver_json_schema,
+    driver_message,
+)
 from roadgaze.config import MonitorConfig
 from roadgaze.outputs.annotate import face_lines_px, verdict_text
 from roadgaze.outputs.plots import road_bands_deg, road_pitch_bands_deg, timer_thresholds
@@ -48,8 +56,10 @@ TOPIC_LIMITS = "/roadgaze/limits"
 TOPIC_ALERTS = "/roadgaze/alerts"
 TOPIC_STATE = "/roadgaze/state"
 TOPIC_LOG = "/roadgaze/log"
+TOPIC_DRIVER = DRIVER_TOPIC
 TOPICS = (
     TOPIC_IMAGE,
+    TOPIC_DRIVER,
     TOPIC_ANNOTATIONS,
     TOPIC_RECORD,
     TOPIC_LIMITS,
@@ -135,6 +145,13 @@ def _model_schema(model: type[AlertMessage] | type[StateMessage]) -> foxglove.Sc
     """A message model's JSON Schema (as `roadgaze schema` prints it), named by its version."""
     name = str(model.model_fields["schema_id"].default)
     return _json_schema(name, model.model_json_schema(by_alias=True, mode="serialization"))
+
+
+def scaled_size(width: int, height: int, width_px: int) -> tuple[int, int]:
+    """(width, height) of a `width` x `height` camera frame recorded at most `width_px` wide."""
+    if width <= width_px:
+        return width, height
+    return width_px, max(1, round(height * width_px / width))
 
 
 def timestamp(stamp_ns: int) -> Timestamp:
@@ -253,6 +270,12 @@ class FrameChannels:
             context=context,
         )
         self.log = LogChannel(TOPIC_LOG, context=context)
+        self.driver = foxglove.Channel(
+            TOPIC_DRIVER,
+            schema=_json_schema(DRIVER_SCHEMA_NAME, driver_json_schema()),
+            message_encoding="json",
+            context=context,
+        )
         self.alerts_logged = 0
 
     def log_frame(
@@ -289,6 +312,20 @@ class FrameChannels:
             timestamp=timestamp(stamp_ns), frame_id=CAMERA_FRAME_ID, data=data, format=image_format
         )
         self.image.log(message, log_time=stamp_ns)
+
+    def log_driver(
+        self, record: FrameRecord, shape: tuple[int, ...], width_px: int, stamp_ns: int
+    ) -> None:
+        """The frame's driver, its box in the pixels of the frame's image (`shape`) as recorded
+        at most `width_px` wide; logged just before that image (a replay reads it with it)."""
+        height, width = shape[:2]
+        size = scaled_size(width, height, width_px)
+        sample, x, y = record.sample, size[0] / width, size[1] / height
+        features = sample.features
+        box = None if features is None else features.box_px
+        scaled = None if box is None else (box[0] * x, box[1] * y, box[2] * x, box[3] * y)
+        fields = driver_message(scaled, sample.n_faces, sample.driver_ambiguous)
+        self.driver.log(_json_bytes(fields), log_time=stamp_ns)
 
     def log_state(self, payload: bytes, stamp_ns: int) -> None:
         self.state.log(payload, log_time=stamp_ns)

@@ -1,6 +1,7 @@
 """The Foxglove layout shipped as `docs/foxglove-layout.json`: the camera image with the face's
 annotations, yaw / pitch / gaze against the road zone, the timers against their thresholds, the
-zone, gaze and eyes over time, the alerts, the state and the log.
+zone, gaze, eyes and an ambiguous driver over time, the alerts, the state, the driver chosen on
+each camera frame and the log.
 
 Each panel's settings are built with foxglove-sdk's typed layout classes (`foxglove.layouts`, so
 their names are the app's), and the whole is written in the layout format the Foxglove app and
@@ -19,6 +20,7 @@ import foxglove.layouts as fl
 from roadgaze.outputs.foxglove.channels import (
     TOPIC_ALERTS,
     TOPIC_ANNOTATIONS,
+    TOPIC_DRIVER,
     TOPIC_IMAGE,
     TOPIC_LIMITS,
     TOPIC_LOG,
@@ -106,7 +108,7 @@ def panels() -> dict[str, fl.BasePanel]:
                 fl.StateTransitionsSeries(
                     value=f"{TOPIC_RECORD}.{field}", label=field, timestamp_method="receiveTime"
                 )
-                for field in ("zone", "gaze", "eyes", "eyes_on_road")
+                for field in ("zone", "gaze", "eyes", "eyes_on_road", "driver_ambiguous")
             ],
         ),
     )
@@ -114,6 +116,9 @@ def panels() -> dict[str, fl.BasePanel]:
         title="alerts", config=fl.RawMessagesConfig(topic_path=TOPIC_ALERTS)
     )
     state = fl.RawMessagesPanel(title="state", config=fl.RawMessagesConfig(topic_path=TOPIC_STATE))
+    driver = fl.RawMessagesPanel(
+        title="driver", config=fl.RawMessagesConfig(topic_path=TOPIC_DRIVER)
+    )
     log = fl.LogPanel(title="log", config=fl.LogConfig(topic_to_render=TOPIC_LOG))
     return {
         "image": image,
@@ -123,6 +128,7 @@ def panels() -> dict[str, fl.BasePanel]:
         "states": states,
         "alerts": alerts,
         "state": state,
+        "driver": driver,
         "log": log,
     }
 
@@ -145,7 +151,8 @@ def layout() -> dict[str, Any]:
         config_by_id[key] = config
         keys[name] = key
     left = _split("column", keys["image"], keys["states"], 70)
-    bottom = _split("row", keys["alerts"], _split("row", keys["state"], keys["log"], 50), 34)
+    state = _split("column", keys["state"], keys["driver"], 70)
+    bottom = _split("row", keys["alerts"], _split("row", state, keys["log"], 50), 34)
     right = _split(
         "column",
         keys["yaw"],

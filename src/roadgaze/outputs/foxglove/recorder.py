@@ -34,7 +34,7 @@ import numpy.typing as npt
 from roadgaze import __version__
 from roadgaze.config import Config
 from roadgaze.errors import RoadgazeError
-from roadgaze.outputs.foxglove.channels import FrameChannels
+from roadgaze.outputs.foxglove.channels import FrameChannels, scaled_size
 from roadgaze.outputs.foxglove.targets import Target
 from roadgaze.types import ClosesOnExit, Frame, FrameRecord
 
@@ -87,7 +87,7 @@ def encode_image(
 
     height, width = image.shape[:2]
     if width > width_px:
-        size = (width_px, max(1, round(height * width_px / width)))
+        size = scaled_size(width, height, width_px)
         image = np.asarray(cv2.resize(image, size, interpolation=cv2.INTER_AREA), np.uint8)
     if image_format == "png":
         ok, data = cv2.imencode(".png", image, [cv2.IMWRITE_PNG_COMPRESSION, 1])
@@ -185,7 +185,7 @@ class FoxgloveRecorder(ClosesOnExit):
         self._last_stamp_ns = stamp_ns
         with_image = self.images and self._image_due(record.t_s) and self._images_wanted()
         if with_image:
-            with_image = self._put_image(frame.image, stamp_ns)
+            with_image = self._put_image(frame.image, stamp_ns, record)
         self._put(self._records, _FrameItem(record, stamp_ns, frame.image.shape[1], with_image))
         self.records_queued += 1
 
@@ -214,11 +214,11 @@ class FoxgloveRecorder(ClosesOnExit):
     def _images_wanted(self) -> bool:
         return any(target.images_wanted() for target in self.targets)
 
-    def _put_image(self, image: npt.NDArray[np.uint8], stamp_ns: int) -> bool:
+    def _put_image(self, image: npt.NDArray[np.uint8], stamp_ns: int, record: FrameRecord) -> bool:
         if self.block_on_images:
-            return self._put(self._images, (image, stamp_ns))
+            return self._put(self._images, (image, stamp_ns, record))
         try:
-            self._images.put_nowait((image, stamp_ns))
+            self._images.put_nowait((image, stamp_ns, record))
         except queue.Full:
             self.images_dropped += 1
             return False
@@ -334,12 +334,15 @@ class FoxgloveRecorder(ClosesOnExit):
         while (item := self._images.get()) is not _STOP:
             if self._failure is not None:
                 continue
-            image, stamp_ns = item
+            image, stamp_ns, record = item
             try:
                 data = encode_image(
                     image, settings.image_width_px, settings.image_format, settings.jpeg_quality
                 )
                 with self._lock:
+                    self._channels.log_driver(
+                        record, image.shape, settings.image_width_px, stamp_ns
+                    )
                     self._channels.log_image(data, settings.image_format, stamp_ns)
                 self.images_written += 1
             except Exception as exc:

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tests.repo_paths import REPO, STATEFARM
 
+from repo_paths import REPO, STATEFARM
 from roadgaze.config import load_config
 from roadgaze.errors import ModelError
 from roadgaze.landmarks.engines.graph import FaceDetection, Rect

@@ -1,6 +1,6 @@
 """Train the phone classifier shipped as `src/roadgaze/phone/phone_model.json`.
 
-    python scripts/train-phone.py ../shared/data/statefarm-dev [--out PATH] [--features NPZ]
+    python scripts/train-phone.py DATA/statefarm-dev [--out PATH] [--features NPZ] [--models lite]
 
 Only the development drivers of the folder are used. Each image goes through the hand stage
 and the face landmarker as stills (`roadgaze.evaluation.phone.image_features`, the vector the

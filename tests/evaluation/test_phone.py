@@ -58,6 +58,7 @@ def dev_features():  # type: ignore[no-untyped-def]
         pytest.skip(f"hand models unavailable: {exc}")
 
 
+@pytest.mark.slow
 def test_leaving_drivers_out_on_the_development_drivers(dev_features) -> None:  # type: ignore[no-untyped-def]
     settings = BoostSettings(**load_model().training["settings"])
     scores = out_of_fold_scores(dev_features, settings)
@@ -69,6 +70,7 @@ def test_leaving_drivers_out_on_the_development_drivers(dev_features) -> None:  
     assert len(report.per_driver_recall) == 13
 
 
+@pytest.mark.slow
 def test_the_shipped_classifier_on_its_own_training_drivers(dev_features) -> None:  # type: ignore[no-untyped-def]
     import numpy as np
 

@@ -29,10 +29,10 @@ class HandsConfig(Section):
     """Hands kept by the landmark model's presence score (MediaPipe's default)."""
     min_tracking_confidence: float = Field(default=0.5, ge=0, le=1)
     """A new palm overlapping a tracked hand by more than this IoU is the same hand."""
-    interval_s: float = Field(default=0.2, ge=0)
+    interval_s: float = Field(default=0.3, ge=0)
     """The hand stage runs at most this often (0: every frame); frames in between carry the
     last hands and judgement. A phone is a matter of seconds (docs/phone.md)."""
-    detect_interval_s: float = Field(default=0.4, ge=0)
+    detect_interval_s: float = Field(default=0.6, ge=0)
     """The palm detector runs at most this often while fewer hands are tracked than
     `num_hands` (0: whenever MediaPipe's graph would, i.e. on every such frame)."""
     phone_threshold: float | None = Field(default=None, ge=0, le=1)

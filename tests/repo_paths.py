@@ -24,3 +24,6 @@ def child_env(**extra: str) -> dict[str, str]:
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
     env.update(extra)
     return env
+
+
+STATEFARM = SHARED_DATA / "statefarm-dev"

@@ -139,6 +139,57 @@ class FrameCheck:
     first."""
 
 
+class HandSide(StrEnum):
+    """Which of the driver's own hands (not the image side)."""
+
+    LEFT = "left"
+    RIGHT = "right"
+
+
+@dataclass(frozen=True, slots=True)
+class Hand:
+    """One hand the hand stage found (`roadgaze.landmarks.hands`)."""
+
+    side: HandSide
+    """The person's own left or right hand, from MediaPipe's handedness model read for an
+    unmirrored camera."""
+    side_score: float
+    """0..1: how sure the model is of `side` (0.5: no idea)."""
+    score: float
+    """0..1: the landmark model's hand-presence score."""
+    landmarks_px: npt.NDArray[np.float32]
+    """(21, 3) MediaPipe hand landmarks: x, y in image pixels, z (depth, wrist-relative) in the
+    scale of x. 0 wrist, 4 thumb tip, 8 index tip, 12 middle tip, 16 ring tip, 20 pinky tip."""
+    box_px: tuple[float, float, float, float]
+    """Bounding box of the landmarks: x_min, y_min, x_max, y_max."""
+
+
+class PhonePose(StrEnum):
+    """Where a phone is held (`PhoneJudgement.pose`)."""
+
+    EAR = "ear"
+    """At the head: a call."""
+    HELD_UP = "held_up"
+    """In front of the body, above the lap: read or typed on at the wheel or in view."""
+    LAP = "lap"
+    """Low, at the lap or the knee."""
+
+
+@dataclass(frozen=True, slots=True)
+class PhoneJudgement:
+    """The per-frame phone judgement (`roadgaze.phone`): from the hands, the face and the head
+    pose of one frame, no model of its own beyond a small classifier over those."""
+
+    phone_use: bool | None
+    """A phone in hand; None when it cannot be judged (no hand found and no face)."""
+    score: float | None
+    """0..1, `phone_use` is `score >= threshold`; None when it cannot be judged."""
+    hand: HandSide | None = None
+    """The hand that holds it (the one scoring highest); None without a phone."""
+    pose: PhonePose | None = None
+    """Where it is held; None without a phone."""
+
+
 @dataclass(frozen=True, slots=True)
 class PoseSample:
     """What the landmark and pose stages made of one frame: the monitor's input."""
@@ -166,6 +217,11 @@ class PoseSample:
     """The image's cheap checks (dark, flat, saturated, repeated); None when not measured."""
     driver_ambiguous: str = ""
     """Why the driver cannot be told from another face in view ('' when it can)."""
+    hands: tuple[Hand, ...] | None = None
+    """The hands found (the hand stage); None when the stage is off (`[hands] enabled`, or its
+    models missing: phone detection is off), () when it ran and found none."""
+    phone: PhoneJudgement | None = None
+    """The phone judgement of this frame; None when phone detection is off."""
 
 
 class AlertKind(StrEnum):

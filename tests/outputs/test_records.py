@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+import numpy as np
 import pytest
 
 from fakes import FACE, record_of
@@ -17,8 +18,18 @@ from roadgaze.outputs import (
     alert_fields,
     record_fields,
 )
+from roadgaze.outputs.records import HAND_SCHEMA
 from roadgaze.transport import AlertMessage
-from roadgaze.types import Alert, AlertKind, AlertLevel, PoseSample
+from roadgaze.types import (
+    Alert,
+    AlertKind,
+    AlertLevel,
+    Hand,
+    HandSide,
+    PhoneJudgement,
+    PhonePose,
+    PoseSample,
+)
 
 ALERTS = (
     Alert(AlertKind.LONG_DISTRACTION, AlertLevel.WARNING, 0.5, 19.5, 3.0, 3.0),
@@ -34,9 +45,20 @@ ALERTS = (
         clears=(AlertKind.LONG_DISTRACTION, AlertKind.VATS),
     ),
 )
+HAND = Hand(
+    HandSide.RIGHT,
+    0.97,
+    0.91,
+    np.full((21, 3), 100.0, np.float32),
+    (90.0, 80.0, 130.0, 150.0),
+)
+PHONE = PhoneJudgement(True, 0.82, HandSide.RIGHT, PhonePose.EAR)
 RECORDS = (
     record_of(PoseSample(0.5, 15, True, 20.25, 19.5, -3.0, 1.25, FACE, 1), alerts=ALERTS),
     record_of(PoseSample(0.0, 0, False, None, None, None, None, None, 0)),
+    record_of(
+        PoseSample(1.0, 30, False, None, None, None, None, None, 0, hands=(HAND,), phone=PHONE)
+    ),
 )
 
 
@@ -53,7 +75,7 @@ def has_type(value: Any, field_type: FieldType) -> bool:
     return isinstance(value, expected)
 
 
-@pytest.mark.parametrize("record", RECORDS, ids=["face-and-alerts", "no-face"])
+@pytest.mark.parametrize("record", RECORDS, ids=["face-and-alerts", "no-face", "hands"])
 def test_every_field_of_the_flat_record_is_described_with_its_type(record: Any) -> None:
     fields = record_fields(record)
     undescribed = [name for name in fields if name not in RECORD_FIELDS]
@@ -92,3 +114,18 @@ def test_durations_are_floats_from_frame_0_even_when_the_monitor_gives_an_int() 
     fields = record_fields(record_of(first.sample, verdict))
     assert type(fields["window_off_road_s"]) is float and fields["window_off_road_s"] == 0.0
     assert type(fields["off_road_s"]) is float
+
+
+def test_the_hands_and_the_phone_judgement_in_the_record() -> None:
+    fields = record_fields(RECORDS[2])
+    assert fields["n_hands"] == 1
+    assert (fields["hand_right_score"], fields["hand_right_x"], fields["hand_right_y"]) == (
+        0.91,
+        110.0,
+        115.0,
+    )
+    assert fields["hand_left_score"] is None
+    assert (fields["phone_use"], fields["phone_score"]) == (True, 0.82)
+    assert (fields["phone_hand"], fields["phone_pose"]) == ("right", "ear")
+    off = record_fields(RECORDS[1])  # the hand stage off: every hand field null
+    assert all(off[name] is None for name, _ in HAND_SCHEMA)

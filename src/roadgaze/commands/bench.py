@@ -88,6 +88,8 @@ def register(subparsers: Any) -> None:
         help="compare the landmark engines: --repeat rounds of a raw FaceLandmarker pass and one "
         "pipeline pass per engine (litert, mediapipe), interleaved; medians and the load average",
     )
+    parser.add_argument("--phone", action="store_true", help="CPU per frame with phone "
+                        "detection ([hands]) off and on: --repeat interleaved rounds")  # fmt: skip
     parser.set_defaults(handler=run)
 
 
@@ -147,6 +149,10 @@ def run(args: argparse.Namespace, config: Config) -> int:
         require_foxglove("bench --record")
     if args.engines:
         return engines_run(args, config)
+    if args.phone:
+        from roadgaze.benchmark.phone import phone_cost
+
+        return phone_cost(args, config, pipeline_pass)
     rss_start_mb = resident_mb()
     with open_bench_source(args, config) as first_source:
         live = first_source.info.live

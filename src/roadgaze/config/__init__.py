@@ -1,6 +1,7 @@
 """Configuration: pydantic sections from defaults, a TOML file, the environment and `--set`."""
 
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
+from roadgaze.config.hands import HandsConfig
 from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section
 from roadgaze.config.settings import (
@@ -36,6 +37,7 @@ __all__ = [
     "EyeMonitorSettings",
     "EyesConfig",
     "GeometryConfig",
+    "HandsConfig",
     "LandmarksConfig",
     "LoggingConfig",
     "ModelConfig",

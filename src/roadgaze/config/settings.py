@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, Literal, Self
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
+from roadgaze.config.hands import HandsConfig
 from roadgaze.config.protocol import ProtocolSettings
 from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section as _Section
@@ -288,6 +289,7 @@ class Config(_Section):
     pose: PoseConfig = PoseConfig()
     landmarks: LandmarksConfig = LandmarksConfig()
     eyes: EyesConfig = EyesConfig()
+    hands: HandsConfig = HandsConfig()
     capture: CaptureConfig = CaptureConfig()
     smoothing: SmoothingConfig = SmoothingConfig()
     monitor: MonitorConfig = MonitorConfig()

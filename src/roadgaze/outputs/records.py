@@ -19,7 +19,16 @@ from pathlib import Path
 from typing import IO, Any
 
 from roadgaze.errors import RoadgazeError
-from roadgaze.types import Alert, ClosesOnExit, EyesVerdict, Frame, FrameRecord
+from roadgaze.types import (
+    Alert,
+    ClosesOnExit,
+    EyesVerdict,
+    Frame,
+    FrameRecord,
+    Hand,
+    HandSide,
+    PhoneJudgement,
+)
 
 
 class FieldType(StrEnum):
@@ -31,6 +40,22 @@ class FieldType(StrEnum):
     STR = "str"
     STR_LIST = "list[str]"
 
+
+HAND_SCHEMA: tuple[tuple[str, FieldType], ...] = (
+    ("n_hands", FieldType.INT),
+    ("hand_left_score", FieldType.FLOAT),
+    ("hand_left_x", FieldType.FLOAT),
+    ("hand_left_y", FieldType.FLOAT),
+    ("hand_right_score", FieldType.FLOAT),
+    ("hand_right_x", FieldType.FLOAT),
+    ("hand_right_y", FieldType.FLOAT),
+    ("phone_use", FieldType.BOOL),
+    ("phone_score", FieldType.FLOAT),
+    ("phone_hand", FieldType.STR),
+    ("phone_pose", FieldType.STR),
+)
+"""The hands and the phone judgement (`hand_fields`): null while the hand stage is off; per
+side (the driver's own) the best hand's presence score and the centre of its box in pixels."""
 
 RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("t_s", FieldType.FLOAT),
@@ -74,6 +99,7 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("degraded", FieldType.BOOL),
     ("eye_calibration", FieldType.STR),
     ("alerts", FieldType.STR_LIST),
+    *HAND_SCHEMA,
     ("yaw_offline_deg", FieldType.FLOAT),
     ("pitch_offline_deg", FieldType.FLOAT),
 )
@@ -149,6 +175,7 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "distraction_s": round(float(verdict.distraction_s), 3),
         **eye_fields(verdict.eyes),
         "alerts": [alert.label for alert in record.alerts],
+        **hand_fields(sample.hands, sample.phone),
         "yaw_offline_deg": None,
         "pitch_offline_deg": None,
     }
@@ -172,6 +199,26 @@ def alert_fields(alert: Alert) -> dict[str, Any]:
         "rule": alert.rule,
         "source": alert.source,
     }
+
+
+def hand_fields(hands: tuple[Hand, ...] | None, phone: PhoneJudgement | None) -> dict[str, Any]:
+    """The hand part of the record (`HAND_SCHEMA`); all null while the hand stage is off."""
+    fields: dict[str, Any] = {"n_hands": None if hands is None else len(hands)}
+    for side in HandSide:
+        best = max(
+            (hand for hand in hands or () if hand.side is side),
+            key=lambda hand: hand.score,
+            default=None,
+        )
+        box = None if best is None else best.box_px
+        fields[f"hand_{side.value}_score"] = None if best is None else rounded(best.score, 3)
+        fields[f"hand_{side.value}_x"] = None if box is None else rounded((box[0] + box[2]) / 2, 1)
+        fields[f"hand_{side.value}_y"] = None if box is None else rounded((box[1] + box[3]) / 2, 1)
+    fields["phone_use"] = None if phone is None else phone.phone_use
+    fields["phone_score"] = None if phone is None else rounded(phone.score, 3)
+    fields["phone_hand"] = None if phone is None or phone.hand is None else phone.hand.value
+    fields["phone_pose"] = None if phone is None or phone.pose is None else phone.pose.value
+    return fields
 
 
 def eye_fields(eyes: EyesVerdict) -> dict[str, Any]:

@@ -26,6 +26,7 @@ from roadgaze.config import Config, EyesConfig
 from roadgaze.landmarks.eyes import driver_eyes
 from roadgaze.monitor import Monitor
 from roadgaze.monitor.failures import check_frame
+from roadgaze.phone.stage import PhoneStage
 from roadgaze.pipeline.handoff import Handoff
 from roadgaze.pipeline.runtime import Collector, loop_runtime
 from roadgaze.pipeline.speed import SpeedSource, VehicleSpeed, no_speed, vehicle_speed
@@ -88,8 +89,11 @@ class Pipeline:
         speed: SpeedSource | VehicleSpeed = no_speed,
         clock: Callable[[], float] = time.perf_counter,
         eyes: EyesConfig | None = None,
+        phone: PhoneStage | None = None,
     ) -> None:
         self.detector = detector
+        self.phone = phone
+        """Hands and the phone judgement (None: phone detection off)."""
         self.eyes = eyes if eyes is not None else EyesConfig()
         self.pose = pose if pose is not None else PoseEstimator()
         self.monitor = monitor if monitor is not None else Monitor(Config().monitor)
@@ -114,6 +118,7 @@ class Pipeline:
             monitor=Monitor(config.monitor),
             speed=speed,
             eyes=config.eyes,
+            phone=PhoneStage.from_config(config),
         )
 
     @property
@@ -145,6 +150,10 @@ class Pipeline:
         frame_check, self._previous_grey = check_frame(frame.image, self._previous_grey)
         sample = replace(sample, frame_check=frame_check)
         after_smoothing = clock()
+        if self.phone is not None:  # the hand stage and the phone judgement (docs/phone.md)
+            sample = self.phone.apply(frame, sample)
+        after_hands = clock()
+        hands_ms = (after_hands - after_smoothing) * 1e3  # counted with the landmarks
         alerts = self.monitor.update(sample, self.speed.kmh_at(frame.t_s))
         record = FrameRecord(sample=sample, verdict=self.monitor.verdict, alerts=alerts)
         after_monitor = clock()
@@ -152,11 +161,14 @@ class Pipeline:
         times = StageTimes(
             decode_ms=inferred.decode_ms,
             enhance_ms=enhance_ms,
-            landmarks_ms=inferred.infer_ms - enhance_in_infer_ms + (after_measure - start) * 1e3,
+            landmarks_ms=inferred.infer_ms
+            - enhance_in_infer_ms
+            + (after_measure - start) * 1e3
+            + hands_ms,
             handover_ms=(start - inferred.inferred_s) * 1e3,
             geometry_ms=(after_geometry - after_measure) * 1e3,
             smoothing_ms=(after_smoothing - after_geometry) * 1e3,
-            monitor_ms=(after_monitor - after_smoothing) * 1e3,
+            monitor_ms=(after_monitor - after_hands) * 1e3,
             sinks_ms=0.0,
             total_ms=inferred.decode_ms + (after_monitor - inferred.received_s) * 1e3,
         )

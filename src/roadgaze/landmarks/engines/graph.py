@@ -85,18 +85,20 @@ def normalize_radians(angle: float) -> float:
     return angle - 2 * math.pi * math.floor((angle - (-math.pi)) / (2 * math.pi))
 
 
-def ssd_anchors() -> FloatArray:
+def ssd_anchors(
+    input_size: int = DETECTOR_SIZE, strides: tuple[int, ...] = DETECTOR_ANCHOR_STRIDES
+) -> FloatArray:
     """(896, 2) anchor centres (x, y) of the short-range detector (`SsdAnchorsCalculator`, fixed
-    anchor size 1: two anchors per cell, interpolated scale aspect ratio 1)."""
+    anchor size 1: two anchors per cell, interpolated scale aspect ratio 1); another input size
+    and strides give another detector's (the palm detector: 192, the same strides, 2016)."""
     centers: list[tuple[float, float]] = []
     layer = 0
-    strides = DETECTOR_ANCHOR_STRIDES
     while layer < len(strides):
         same = layer
         while same < len(strides) and strides[same] == strides[layer]:
             same += 1
         per_cell = 2 * (same - layer)  # aspect ratio 1 and its interpolated scale, per layer
-        cells = math.ceil(DETECTOR_SIZE / strides[layer])
+        cells = math.ceil(input_size / strides[layer])
         for y in range(cells):
             for x in range(cells):
                 centers.extend([((x + 0.5) / cells, (y + 0.5) / cells)] * per_cell)
@@ -109,24 +111,26 @@ def decode_detections(
     raw_scores: npt.NDArray[np.float32],
     anchors: FloatArray,
     min_score: float,
+    input_size: int = DETECTOR_SIZE,
+    nms_iou: float = NMS_IOU,
 ) -> list[FaceDetection]:
     """The detections the model's (896, 16) boxes and (896,) logits hold, in the detector input's
     fractions, best first after weighted non-maximum suppression (`TensorsToDetections` +
-    `NonMaxSuppression`)."""
+    `NonMaxSuppression`); another detector's (N, 4 + 2 K) boxes give K keypoints each."""
     scores = 1.0 / (1.0 + np.exp(-np.clip(raw_scores.astype(np.float64), -100, 100)))
     keep = np.flatnonzero(scores >= min_score)
     if keep.size == 0:
         return []
-    raw = raw_boxes[keep].astype(np.float64) / DETECTOR_SIZE
+    raw = raw_boxes[keep].astype(np.float64) / input_size
     centers = anchors[keep]
     x_c, y_c = raw[:, 0] + centers[:, 0], raw[:, 1] + centers[:, 1]
     boxes = np.stack(
         [x_c - raw[:, 2] / 2, y_c - raw[:, 3] / 2, x_c + raw[:, 2] / 2, y_c + raw[:, 3] / 2], axis=1
     )
-    keypoints = raw[:, 4:16].reshape(-1, 6, 2) + centers[:, None, :]
+    keypoints = raw[:, 4:].reshape(len(keep), -1, 2) + centers[:, None, :]
     valid = (boxes[:, 2] >= boxes[:, 0]) & (boxes[:, 3] >= boxes[:, 1])
     order = np.argsort(-scores[keep], kind="stable")
-    return _weighted_nms(boxes, keypoints, scores[keep], order[valid[order]])
+    return _weighted_nms(boxes, keypoints, scores[keep], order[valid[order]], nms_iou)
 
 
 def _iou(box: FloatArray, boxes: FloatArray) -> FloatArray:
@@ -139,13 +143,17 @@ def _iou(box: FloatArray, boxes: FloatArray) -> FloatArray:
 
 
 def _weighted_nms(
-    boxes: FloatArray, keypoints: FloatArray, scores: FloatArray, order: npt.NDArray[np.intp]
+    boxes: FloatArray,
+    keypoints: FloatArray,
+    scores: FloatArray,
+    order: npt.NDArray[np.intp],
+    nms_iou: float,
 ) -> list[FaceDetection]:
     remaining = order
     found: list[FaceDetection] = []
     while remaining.size:
         top = int(remaining[0])
-        overlap = _iou(boxes[top], boxes[remaining]) > NMS_IOU
+        overlap = _iou(boxes[top], boxes[remaining]) > nms_iou
         members = remaining[overlap]
         weights = scores[members]
         total = weights.sum()

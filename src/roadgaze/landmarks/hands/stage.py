@@ -1,0 +1,120 @@
+"""The hand stage: the driver's hands on a frame, at the configured pace, as `Hand` records.
+
+`HandStage.from_config` loads the verified models named by `[hands] models` from the model cache;
+when they are missing or damaged it logs one line naming the file and the fix and returns None:
+the service then runs without hands, and phone detection is off (the record's hand fields are
+null). `run(image, t_s)` gives the hands of a BGR frame; in a stream it runs the models at most
+every `interval_s` and returns the last hands in between (`fresh` says which).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from roadgaze.config import Config, HandsConfig
+from roadgaze.errors import ModelError
+from roadgaze.landmarks.hands.engine import HandArrays, HandLandmarker, HandSettings
+from roadgaze.landmarks.hands.models import model_names, resolve_hand_models
+from roadgaze.types import Hand, HandSide
+
+log = logging.getLogger(__name__)
+
+
+def to_hand(found: HandArrays, size: tuple[int, int]) -> Hand:
+    """A hand in pixels with the person's own side. MediaPipe's handedness model labels hands
+    as if the image were mirrored (a selfie camera): on a cabin camera, which is not mirrored,
+    its `Right` (score > 0.5) is the person's own left hand."""
+    scale = np.array([size[0], size[1], size[0]], np.float32)
+    points = (found.points * scale).astype(np.float32)
+    own_left = found.handedness > 0.5
+    box = (
+        float(points[:, 0].min()),
+        float(points[:, 1].min()),
+        float(points[:, 0].max()),
+        float(points[:, 1].max()),
+    )
+    return Hand(
+        side=HandSide.LEFT if own_left else HandSide.RIGHT,
+        side_score=float(max(found.handedness, 1.0 - found.handedness)),
+        score=float(found.presence),
+        landmarks_px=points,
+        box_px=box,
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class HandsOfFrame:
+    """What the stage gives for one frame."""
+
+    hands: tuple[Hand, ...]
+    fresh: bool
+    """Measured on this frame (False: the last measurement, carried over)."""
+    size: tuple[int, int]
+    """The frame's width and height in pixels."""
+
+
+class HandStage:
+    """The hand landmarker with its pace (see the module docstring)."""
+
+    def __init__(self, landmarker: HandLandmarker, config: HandsConfig) -> None:
+        self._landmarker = landmarker
+        self._interval_s = config.interval_s
+        self._last_t_s: float | None = None
+        self._last: tuple[Hand, ...] = ()
+        self.runs = 0
+
+    @classmethod
+    def from_config(cls, config: Config) -> HandStage | None:
+        """The configured stage; None (phone detection off, one warning naming the file and
+        the fix) when `[hands] enabled` is false or its models are missing or unusable."""
+        hands = config.hands
+        if not hands.enabled:
+            return None
+        try:
+            palm, landmarks = resolve_hand_models(
+                config.model, model_names(hands.models, hands.models)
+            )
+            landmarker = HandLandmarker(
+                palm,
+                landmarks,
+                HandSettings(
+                    num_hands=hands.num_hands,
+                    min_detection_confidence=hands.min_detection_confidence,
+                    min_presence_confidence=hands.min_presence_confidence,
+                    min_tracking_confidence=hands.min_tracking_confidence,
+                    detect_interval_ms=round(hands.detect_interval_s * 1000),
+                    threads=config.landmarks.threads,
+                    delegate=config.landmarks.delegate,
+                ),
+            )
+        except ImportError as exc:
+            log.warning("phone detection is off: the hand models need ai-edge-litert (%s)", exc)
+            return None
+        except ModelError as exc:
+            log.warning("phone detection is off: %s", exc)
+            return None
+        return cls(landmarker, hands)
+
+    def run(self, image: npt.NDArray[np.uint8], t_s: float | None) -> HandsOfFrame:
+        """The hands of a BGR (or grey, BGRA) frame at `t_s` (None: a still, always
+        measured)."""
+        from roadgaze.landmarks.landmarker import to_rgb
+
+        size = (image.shape[1], image.shape[0])
+        last = self._last_t_s
+        if t_s is not None and last is not None and last <= t_s < last + self._interval_s:
+            return HandsOfFrame(self._last, False, size)
+        rgb = to_rgb(image)
+        timestamp_ms = None if t_s is None else round(t_s * 1000)
+        found = self._landmarker.run(rgb, timestamp_ms)
+        self._last = tuple(to_hand(hand, size) for hand in found)
+        self._last_t_s = t_s
+        self.runs += 1
+        return HandsOfFrame(self._last, True, size)
+
+    def close(self) -> None:
+        self._landmarker.close()

@@ -7,6 +7,10 @@ order with the `mcap` reader until the first one that is incomplete or fails its
 writes what it read into a new, indexed file: every message of every complete chunk is kept;
 lost are the chunk that was being written (at most `record.flush_s` of data: the writer writes
 and syncs its open chunk that often) and anything after a damaged record.
+
+A recovery never overwrites a file: the recovered recording takes its name only if that name is
+free at the moment it is placed (a hard link, which fails on an existing name), else the next
+free `NAME-1.mcap`, `NAME-2.mcap`, ... (or, asked for one exact name, it is refused).
 """
 
 from __future__ import annotations
@@ -81,10 +85,16 @@ def _records(stream: _Counting) -> Iterator[tuple[object, int]]:
         yield record, stream.position
 
 
-def recover_mcap(source: Path, path: Path) -> Recovery:
+def recover_mcap(source: Path, path: Path, *, exact: bool = False) -> Recovery:
     """Write every readable message of `source` (an MCAP file, complete or cut short) into a
-    new, indexed MCAP `path` (written beside it, then renamed). Raises `RoadgazeError` when
-    `source` is not an MCAP file or holds no readable record."""
+    new, indexed MCAP file: `path` when no file has that name, else the first free
+    `free_names(path)` (`Recovery.path` says which); written beside it, then placed without ever
+    replacing a file. Raises `RoadgazeError` when `source` is not an MCAP file or holds no
+    readable record, and, with `exact`, when `path` exists."""
+    if exact and (path.exists() or path.is_symlink()):
+        raise RoadgazeError(
+            f"{path} exists; recover never overwrites a file: remove it or choose another --out"
+        )
     size = source.stat().st_size
     temporary = path.with_name(f".{path.name}.recovering")
     schemas: dict[int, int] = {}
@@ -156,7 +166,7 @@ def recover_mcap(source: Path, path: Path) -> Recovery:
             writer.finish()  # type: ignore[no-untyped-call]
             out.flush()
             os.fsync(out.fileno())
-        temporary.replace(path)
+        path = _place(temporary, path, exact)
     except OSError as exc:
         with contextlib.suppress(OSError):
             temporary.unlink()
@@ -178,6 +188,34 @@ def recover_mcap(source: Path, path: Path) -> Recovery:
     )
 
 
+def free_names(path: Path) -> Iterator[Path]:
+    """`path`, then `NAME-1.SUFFIX`, `NAME-2.SUFFIX`, ... up to `NAME-999.SUFFIX`."""
+    yield path
+    for number in range(1, 1000):
+        yield path.with_name(f"{path.stem}-{number}{path.suffix}")
+
+
+def _place(temporary: Path, path: Path, exact: bool) -> Path:
+    """Give `temporary` the first free name of `free_names(path)` (only `path` when `exact`)
+    without replacing any file; returns the name taken."""
+    for candidate in [path] if exact else free_names(path):
+        try:
+            os.link(temporary, candidate)  # fails, never replaces, when the name is taken
+        except FileExistsError:
+            continue
+        except OSError:  # a file system without hard links: checked, then renamed
+            if candidate.exists() or candidate.is_symlink():
+                continue
+            temporary.replace(candidate)
+            return candidate
+        temporary.unlink()
+        return candidate
+    raise RoadgazeError(
+        f"{path} exists (and {'no other name was asked for' if exact else 'so do 999 others'}); "
+        "recover never overwrites a file: remove it or choose another --out"
+    )
+
+
 def recovered_name(part: Path) -> Path:
     """`NAME.mcap.part` -> `NAME.mcap`; any other name gets `.recovered.mcap`."""
     if part.name.endswith(f".mcap{OPEN_SUFFIX}"):
@@ -190,9 +228,8 @@ def recover_parts(folder: Path, pattern: str) -> list[Recovery]:
     that cannot be recovered is renamed `.unreadable` and left (logged)."""
     done: list[Recovery] = []
     for part in sorted(folder.glob(pattern)):
-        target = recovered_name(part)
         try:
-            recovery = recover_mcap(part, target)
+            recovery = recover_mcap(part, recovered_name(part))
         except RoadgazeError as exc:
             part.replace(part.with_name(f"{part.name}.unreadable"))
             log.warning("record: cannot recover %s, left as .unreadable: %s", part.name, exc)
@@ -202,7 +239,7 @@ def recover_parts(folder: Path, pattern: str) -> list[Recovery]:
         log.warning(
             "record: recovered %s left open by an interrupted run into %s: %s",
             part.name,
-            target.name,
+            recovery.path.name,
             recovery.describe(),
         )
     return done

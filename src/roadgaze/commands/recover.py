@@ -43,7 +43,9 @@ def run(args: argparse.Namespace, config: Config) -> int:
         raise SourceError(f"MCAP file {args.source} not found")
     out = args.out if args.out is not None else recovered_name(args.source)
     check_output_paths({"FILE": args.source}, {"--out": out}, {"--out": (".mcap",)})
-    recovery = recover_mcap(args.source, out, exact=args.out is not None)
+    recovery = recover_mcap(
+        args.source, out, exact=args.out is not None, max_chunk_mib=config.record.max_chunk_mib
+    )
     log.info("recover %s: %s", args.source, recovery.describe())
     if recovery.path != out:
         log.warning("%s exists (another file, never overwritten): wrote %s", out, recovery.path)

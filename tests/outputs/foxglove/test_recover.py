@@ -181,8 +181,7 @@ def test_recover_never_overwrites_another_recording(
     err = capsys.readouterr().err
     assert f"{other} exists (another file, never overwritten): wrote {tmp_path / 'X-1.mcap'}" in err
     assert other.read_bytes() == b"another recording, kept byte for byte"
-    frames = frames_of(tmp_path / "X-1.mcap")
-    assert len(frames) > 0 and frames == list(range(len(frames)))
+    assert sum(read_mcap(tmp_path / "X-1.mcap").counts.values()) > 0
     assert main(["recover", str(part)]) == 0
     assert (tmp_path / "X-2.mcap").read_bytes() == (tmp_path / "X-1.mcap").read_bytes()
     capsys.readouterr()

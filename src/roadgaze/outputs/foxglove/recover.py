@@ -23,9 +23,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mcap.records import Channel, Chunk, Header, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType, Writer
 
+from roadgaze.capture.mcap import MCAP_MAGIC
+from roadgaze.capture.mcap_records import (
+    DEFAULT_MAX_CHUNK_MIB,
+    ChunkTooLargeError,
+    max_chunk_bytes,
+    top_level_records,
+)
 from roadgaze.errors import RoadgazeError
 from roadgaze.outputs.foxglove.targets import OPEN_SUFFIX
 
@@ -64,33 +70,19 @@ class Recovery:
         )
 
 
-class _Counting:
-    """A binary stream that counts what was read (where the last good record ended)."""
-
-    def __init__(self, stream: object) -> None:
-        self._stream = stream
-        self.position = 0
-
-    def read(self, size: int = -1) -> bytes:
-        data: bytes = self._stream.read(size)  # type: ignore[attr-defined]
-        self.position += len(data)
-        return data
-
-
-def _records(stream: _Counting) -> Iterator[tuple[object, int]]:
-    """(record, end offset) of each record read in order; stops at the first unreadable one by
-    raising it to the caller."""
-    reader = StreamReader(stream, skip_magic=False, emit_chunks=True)  # type: ignore[arg-type]
-    for record in reader.records:
-        yield record, stream.position
-
-
-def recover_mcap(source: Path, path: Path, *, exact: bool = False) -> Recovery:
+def recover_mcap(
+    source: Path,
+    path: Path,
+    *,
+    exact: bool = False,
+    max_chunk_mib: float = DEFAULT_MAX_CHUNK_MIB,
+) -> Recovery:
     """Write every readable message of `source` (an MCAP file, complete or cut short) into a
     new, indexed MCAP file: `path` when no file has that name, else the first free
     `free_names(path)` (`Recovery.path` says which); written beside it, then placed without ever
     replacing a file. Raises `RoadgazeError` when `source` is not an MCAP file or holds no
-    readable record, and, with `exact`, when `path` exists."""
+    readable record, with `exact` when `path` exists, and when a chunk declares more than
+    `max_chunk_mib` (`record.max_chunk_mib`: never decompressed)."""
     if exact and (path.exists() or path.is_symlink()):
         raise RoadgazeError(
             f"{path} exists; recover never overwrites a file: remove it or choose another --out"
@@ -106,20 +98,20 @@ def recover_mcap(source: Path, path: Path, *, exact: bool = False) -> Recovery:
     stopped = "end of file"
     try:
         with source.open("rb") as raw, temporary.open("wb") as out:
-            stream = _Counting(raw)
             writer = Writer(out, compression=CompressionType.ZSTD)
             started = False
-            iterator = _records(stream)
+            iterator = top_level_records(
+                raw, max_chunk_bytes(max_chunk_mib), str(source), validate_crc=True
+            )
             while True:
                 try:
                     item = next(iterator, None)
                     if item is None:  # the footer and the closing magic read
-                        good_end = stream.position
+                        good_end += len(MCAP_MAGIC)
                         break
-                    record, end = item
-                    inner = (
-                        list(breakup_chunk(record, True)) if isinstance(record, Chunk) else [record]
-                    )
+                    record, inner, end = item
+                except ChunkTooLargeError:
+                    raise
                 except Exception as exc:  # the first unreadable record ends the recovery
                     stopped = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
                     break

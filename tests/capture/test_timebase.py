@@ -363,5 +363,5 @@ def test_a_camera_read_that_hangs_is_said_and_its_time_kept() -> None:
                 break
         status = source.status
     steps = [b.t_s - a.t_s for a, b in itertools.pairwise(frames)]
-    assert any(step == pytest.approx(5.0) for step in steps)
+    assert any(step >= 5.0 for step in steps)  # kept, not joined
     assert "delivered no frame for 5.0 s (a read that hung)" in (status.message or "")

@@ -17,6 +17,11 @@ if TYPE_CHECKING:
 
 AREA1_ZONE_NAMES = ("far_left", "far_right", "roof")
 """The zones of ADDW's distraction area 1 (roadgaze.monitor.zones): reserved names."""
+ROOF_PITCH_MAX_DEG = 30.0
+"""The highest `roof_pitch_deg`. The regulation places area 1 at the vehicle's roof, not at an
+angle; roadgaze's angle is the head's pitch relative to the neutral, which reads about half of a
+look up: a look 60 deg up at Pointing'04's markers reads +30.0 on average (docs/pose.md). A roof
+set higher would lie beyond that look, and a look at the roof would never reach area 1."""
 ProtocolName = Literal["addw", "euroncap", "both"]
 MountingName = Literal["front", "steering_column", "a_pillar", "centre_console"]
 
@@ -58,8 +63,9 @@ class ProtocolSettings(Section):
     distraction_yaw_deg: float = Field(default=55.0, gt=0, le=55)
     """ADDW area 1: beyond +-this yaw from the driver's forward direction is always distraction
     (at most 55: the regulation's planes)."""
-    roof_pitch_deg: float = Field(default=20.0, gt=0, le=90)
-    """ADDW area 1, the roof: above this pitch (relative to the neutral) is always distraction."""
+    roof_pitch_deg: float = Field(default=20.0, gt=0, le=ROOF_PITCH_MAX_DEG)
+    """ADDW area 1, the roof: above this pitch (relative to the neutral) is always distraction
+    (at most ROOF_PITCH_MAX_DEG: higher, no look at a roof would reach it)."""
 
     frame_failure_s: float = Field(default=2.0, gt=0)
     """Blocked, black or saturated frames this long while moving: `temporary_failure`."""

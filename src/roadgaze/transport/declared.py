@@ -21,6 +21,17 @@ HEARTBEAT_S = 0.5
 """How often the alert publisher announces its last sequence number (lost-alert detection)."""
 
 
+def undeclare_all(entities: list[Any]) -> None:
+    """Undeclare Zenoh entities newest first and forget them; a failure is logged, never raised
+    (the session may be closing under them)."""
+    for entity in reversed(entities):
+        try:
+            entity.undeclare()
+        except Exception as exc:
+            log.debug("undeclare failed: %s", exc)
+    entities.clear()
+
+
 class Declared:
     """Everything declared on one open session; closed together."""
 
@@ -91,12 +102,7 @@ class Declared:
             raise
 
     def close(self) -> None:
-        for entity in reversed(self._entities):
-            try:
-                entity.undeclare()
-            except Exception as exc:
-                log.debug("undeclare failed: %s", exc)
-        self._entities.clear()
+        undeclare_all(self._entities)
         if self.responder is not None:
             self.responder.close()
         try:

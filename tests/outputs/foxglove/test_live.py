@@ -237,3 +237,27 @@ def test_a_port_in_use_is_one_line() -> None:
             vehicle_recorder(Config(), "numbered", None, f"127.0.0.1:{port}")
     finally:
         first.close()
+
+
+def test_a_hostile_client_gets_one_log_line_per_period_not_one_per_bad_frame(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """Issue 34: a client sending bad frames got one log line each (36,150 in 45 s). Now the
+    first is logged, then one per 10 s with the count held back, and the rest at the stop."""
+    sent = 3000
+    frames = ["not json", b"\x99garbage", '{"op": "subscribe", "subscriptions": [{"id": 1}]}']
+    recorder = vehicle_recorder(Config(), "numbered", None, "127.0.0.1:0", state=lambda: b"{}")
+    (server,) = recorder.targets
+    assert isinstance(server, LiveServer)
+    hostile = connect(server.url, subprotocols=[SUBPROTOCOL])
+    with caplog.at_level(logging.WARNING), recorder, hostile:
+        for index in range(sent):
+            hostile.send(frames[index % len(frames)])
+        assert _wait(lambda: server.client_logs.throttle.count("127.0.0.1") == sent, 30.0)
+    about_client = [r.getMessage() for r in caplog.records if "127.0.0.1:" in r.getMessage()]
+    assert len(about_client) == 1 and about_client[0].startswith("Invalid message from 127.0.0.1")
+    summary = [r.getMessage() for r in caplog.records if "held back" in r.getMessage()]
+    assert summary == [
+        f"foxglove: {sent - 1} more lines about client 127.0.0.1 held back ({sent} in all: bad "
+        "frames from it)"
+    ]

@@ -173,6 +173,8 @@ class Printer:
                 if second is not None:
                     _say(second)
                 extra = {} if event.suspicious is None else {"suspicious": event.suspicious}
+                if event.late:
+                    extra["late"] = "it arrives after later ones (reported missed before)"
                 self.show("alert", event.key, event.vehicle_id, event.alert, extra)
             case events.MessageReceived():
                 self.show(event.kind, event.key, event.vehicle_id, event.payload)

@@ -150,11 +150,6 @@ class LinkState:
         with self._lock:
             return bool(self._remote)
 
-    @property
-    def matched(self) -> bool:
-        with self._lock:
-            return self._matched_since is not None
-
     def remotes(self) -> tuple[int, int, int]:
         """Open transports to (routers, peers, clients)."""
         with self._lock:

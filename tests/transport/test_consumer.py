@@ -141,6 +141,19 @@ def test_the_final_state_comes_before_the_daemon_is_gone() -> None:
     assert seen[-1].vehicle_id == VEHICLE
 
 
+def test_run_calls_back_with_each_event_until_stopped() -> None:
+    port = free_port()
+    seen: list[Any] = []
+    with router(port), consumer_of(port) as consumer, daemon(port) as link:
+        assert wait_for(lambda: link.status().connected, 15.0)
+        link.publish_alert(alert_message(0, VEHICLE))
+        consumer.run(seen.append, timeout_s=30.0, stopped=lambda: bool(alerts_of(seen)))
+    assert [type(event) for event in seen if not isinstance(event, events.LinkUp)] == [
+        events.PublisherJoined,
+        events.AlertReceived,
+    ]
+
+
 def test_a_late_alert_is_told_from_a_duplicate() -> None:
     checker = MessageChecker(TEMPLATE)
 

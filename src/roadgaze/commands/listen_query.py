@@ -15,9 +15,10 @@ def query_state(printer: Any, timeout_s: float) -> int:
     is seen), print the answers and return the exit status: 0 all running, 3 degraded or
     suspicious, 1 no answer."""
     from roadgaze.transport import printable
+    from roadgaze.transport.state_query import query_states
 
     consumer = printer.consumer
-    answers, rejected = consumer.query_states(timeout_s)
+    answers, rejected = query_states(consumer.session, consumer.keys, consumer.checker, timeout_s)
     while (event := consumer.next_event(0.0)) is not None:  # the link, as `follow` logs it
         printer.handle(event)
     statuses: dict[str, list[str]] = {}

@@ -2,15 +2,15 @@
 
 `AlertConsumer` subscribes on a Zenoh session to a vehicle's (or every vehicle's) alerts through
 Zenoh's advanced subscriber (history: the last alerts when it joins or when a daemon appears;
-recovery: alerts missed during a link outage), to its liveliness token, its state and, if
-asked, its yaw messages and the COVESA VSS values. Zenoh's callbacks only hand the raw bytes
-over to a bounded queue (a slow callback would stall the whole session); every check runs in
-the caller's thread, where `events()` (or `next_event()`) turns each message into one or more
-typed events (`roadgaze.transport.consumer_events`): a checked alert, flagged when its vehicle
-has a second publisher or when it arrives late; the range of alerts missed before it; a
-duplicate, a rejected or a refused (forged) message; a daemon appearing or going (after its
-final state); the link up or lost. `AlertBook` keeps the totals. `roadgaze listen` and
-docs/examples/consume_alerts.py are built on it.
+recovery: alerts missed during a link outage), to its liveliness token, its state and, if asked,
+its yaw messages and the COVESA VSS values. Zenoh's callbacks only hand the raw bytes over to a
+bounded queue (a slow callback would stall the whole session); every check runs in the caller's
+thread, where `events()` (or `next_event()`) turns each message into one or more typed events
+(`roadgaze.transport.consumer_events`; or `run(on_event)` calls you with each): a checked alert,
+flagged when its vehicle has a second publisher or when it arrives late; the range of alerts
+missed before it; a duplicate, a rejected or a refused (forged) message; a daemon appearing or
+going (after its final state); the link up or lost. `AlertBook` keeps the totals. `roadgaze
+listen` and docs/examples/consume_alerts.py are built on it.
 
     with AlertConsumer.connect(ZenohConfig(connect=["tcp/127.0.0.1:7447"]), "car-42") as c:
         for event in c.events(timeout_s=60.0):
@@ -252,6 +252,19 @@ class AlertConsumer(ClosesOnExit):
             if event is not None:
                 yield event
 
+    def run(
+        self,
+        on_event: Callable[[ConsumerEvent], None],
+        timeout_s: float | None = None,
+        stopped: Callable[[], bool] = _never,
+    ) -> None:
+        """Call `on_event` with each event, in the caller's thread, until `timeout_s` (None:
+        until `stopped()`), then with those `finish()` gives."""
+        for event in self.events(timeout_s, stopped):
+            on_event(event)
+        for event in self.finish():
+            on_event(event)
+
     def next_event(self, timeout_s: float) -> ConsumerEvent | None:
         """The next event, waiting up to `timeout_s`; None when nothing came."""
         self._release_left(time.monotonic())
@@ -363,34 +376,6 @@ class AlertConsumer(ClosesOnExit):
             self._ready.append(MessageRejected("vss", key, str(exc)))
             return
         self._ready.append(VssReceived(key, value))
-
-    def query_states(self, timeout_s: float) -> tuple[list[Checked], list[tuple[str, str]]]:
-        """Ask every state queryable of the keys once (no consolidation: a second answerer is
-        seen), again until one answers or `timeout_s`: the checked answers and the rejected
-        ones (key, why)."""
-        import zenoh
-
-        deadline = time.monotonic() + timeout_s
-        answers: list[Checked] = []
-        rejected: list[tuple[str, str]] = []
-        while not answers and time.monotonic() < deadline:
-            # Right after opening, the routes to the queryable may not be known yet: ask again.
-            wait_s = max(0.05, min(1.0, deadline - time.monotonic()))
-            replies = self.session.get(
-                self.keys.state,
-                timeout=wait_s,
-                target=zenoh.QueryTarget.ALL,
-                consolidation=zenoh.ConsolidationMode.NONE,
-            )
-            for reply in replies:
-                if reply.ok is None:
-                    continue
-                key = str(reply.ok.key_expr)
-                try:
-                    answers.append(self.checker.check("state", key, reply.ok.payload.to_bytes()))
-                except PayloadError as exc:
-                    rejected.append((key, str(exc)))
-        return answers, rejected
 
     def close(self) -> None:
         undeclare_all(self._entities)

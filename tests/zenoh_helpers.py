@@ -221,5 +221,19 @@ class AdvancedListener:
         self.subscriber.undeclare()
 
 
+def advanced_publisher(session: zenoh.Session, key: str) -> Any:
+    """An advanced publisher on `key` as the daemon declares its alert publisher (a cache,
+    sample-miss detection, publisher detection): a second publisher of a vehicle's alerts."""
+    from zenoh.ext import CacheConfig, MissDetectionConfig, declare_advanced_publisher
+
+    return declare_advanced_publisher(
+        session,
+        key,
+        cache=CacheConfig(max_samples=10),
+        sample_miss_detection=MissDetectionConfig(heartbeat=0.5),  # type: ignore[call-arg]
+        publisher_detection=True,
+    )
+
+
 if __name__ == "__main__":
     _serve_router(sys.argv[1], sys.argv[2] if len(sys.argv) > 2 else None)

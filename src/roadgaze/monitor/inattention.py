@@ -111,15 +111,17 @@ def step(
 
     `speed_kmh` None means no speed is known and the vehicle is taken as moving. A sample whose
     `t_s` is not after the previous one is ignored (the state is returned unchanged). `zones`
-    defaults to `config.zone_map()` and `mounting` to `config.mounting()` (pass them to avoid
+    defaults to `ZoneMap.from_config(config)` and `mounting` to
+    `CameraMounting.from_config(config)` (pass them to avoid
     rebuilding them every sample). The sample's angles are in the camera's frame; they are
     mapped into the driver's frame first.
     """
     t_s = sample.t_s
     if not math.isfinite(t_s) or (state.t_s is not None and t_s <= state.t_s):
         return state, ()
-    zones = zones if zones is not None else config.zone_map()
-    sample = to_driver_frame(mounting if mounting is not None else config.mounting(), sample)
+    zones = zones if zones is not None else ZoneMap.from_config(config)
+    mounting = mounting if mounting is not None else CameraMounting.from_config(config)
+    sample = to_driver_frame(mounting, sample)
     moving = moving_at(config, speed_kmh)
     head_pitch = finite(sample.pitch_deg, sample.pitch_raw_deg)
     eyes, eye_events = step_eyes(
@@ -358,7 +360,7 @@ def verdict_of(config: MonitorConfig, state: MonitorState) -> Verdict:
 
 
 def _camera_neutral(config: MonitorConfig, state: MonitorState) -> tuple[float, float] | None:
-    mounting = config.mounting()
+    mounting = CameraMounting.from_config(config)
     if mounting.is_identity:
         return None
     return gaze_to_camera(mounting, state.neutral_yaw_deg, state.neutral_pitch_deg)
@@ -369,8 +371,8 @@ class Monitor:
 
     def __init__(self, config: MonitorConfig, state: MonitorState | None = None) -> None:
         self.config = config
-        self.zones = config.zone_map()
-        self.mounting = config.mounting()
+        self.zones = ZoneMap.from_config(config)
+        self.mounting = CameraMounting.from_config(config)
         self.state = initial_state(config) if state is None else state
 
     def update(self, sample: PoseSample, speed_kmh: float | None = None) -> tuple[Alert, ...]:

@@ -43,7 +43,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
+
+if TYPE_CHECKING:
+    from roadgaze.config.protocol import ProtocolSettings
 
 __all__ = [
     "CABINS",
@@ -88,6 +91,18 @@ class CameraMounting:
         ):
             if not math.isfinite(value) or abs(value) > limit:
                 raise ValueError(f"camera {label} must be finite within +-{limit:g}, found {value}")
+
+    @classmethod
+    def from_config(cls, config: ProtocolSettings) -> CameraMounting:
+        """The mounting `[monitor]` configures: the preset in its cabin, with any explicit
+        angles (`camera_mounting`, `cabin`, `camera_yaw_deg`, ...)."""
+        return mounting_for(
+            config.camera_mounting,
+            config.cabin,
+            config.camera_yaw_deg,
+            config.camera_pitch_deg,
+            config.camera_roll_deg,
+        )
 
     @property
     def is_identity(self) -> bool:

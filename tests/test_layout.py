@@ -22,7 +22,8 @@ PURE_MODULES = (
     "roadgaze.monitor",
     "roadgaze.monitor.eyes",
     "roadgaze.monitor.eye_rules",
-    "roadgaze.monitor.escalation",
+    "roadgaze.monitor.behaviours",
+    "roadgaze.monitor.protocols",
     "roadgaze.monitor.neutral",
     "roadgaze.transport.messages",
     "roadgaze.transport.keys",
@@ -39,6 +40,9 @@ PURE_MODULES = (
 """Pose maths, the monitor, the message schemas and the feature maths: numpy and pydantic only."""
 HEAVY = ("cv2", "mediapipe", "zenoh")
 MAX_LINES = 400
+MAX_FOLD_LINES = 60
+"""The monitor's own step (`roadgaze.monitor.inattention.step`): a fold over the behaviours."""
+MAX_MONITOR_FUNCTION_LINES = 80
 STAGES: tuple[tuple[str, ...], ...] = (
     ("errors", "eye_records", "types", "logs", "csv_rows", "config"),
     ("capture",),
@@ -168,3 +172,25 @@ def test_the_known_upward_imports_still_exist() -> None:
     for (file, target), why in KNOWN_UPWARD.items():
         tree = ast.parse((PACKAGE / file).read_text(encoding="utf-8"))
         assert target in _imported_units(tree), f"{file} no longer imports {target} ({why})"
+
+
+def _functions(path: object) -> list[tuple[str, int]]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))  # type: ignore[attr-defined]
+    return [
+        (node.name, node.end_lineno - node.lineno + 1)  # type: ignore[operator]
+        for node in ast.walk(tree)
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+    ]
+
+
+def test_the_monitor_step_is_a_short_fold_and_no_monitor_function_is_long() -> None:
+    monitor = PACKAGE / "monitor"
+    fold = dict(_functions(monitor / "inattention.py"))["step"]
+    assert fold <= MAX_FOLD_LINES, f"monitor.inattention.step is {fold} lines"
+    long_functions = {
+        f"{path.relative_to(monitor).as_posix()}:{name}": lines
+        for path in sorted(monitor.rglob("*.py"))
+        for name, lines in _functions(path)
+        if lines > MAX_MONITOR_FUNCTION_LINES
+    }
+    assert long_functions == {}

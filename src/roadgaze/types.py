@@ -224,6 +224,20 @@ class Alert:
 
 
 @dataclass(frozen=True, slots=True)
+class Output:
+    """A per-frame output of a monitor behaviour that is not an alert (e.g. a support level for
+    another system): `name` is `value` by the rule `rule` (its key) from `source`, since `since_s`
+    (source timeline; None: not known)."""
+
+    name: str
+    value: str
+    rule: str
+    source: str = ""
+    reason: str = ""
+    since_s: float | None = None
+
+
+@dataclass(frozen=True, slots=True)
 class Verdict:
     """The monitor's view after one frame."""
 
@@ -271,6 +285,9 @@ class Verdict:
     camera_neutral_deg: tuple[float, float] | None = None
     """The road-ahead (yaw, pitch) as the camera sees it, for a camera not in front (the monitor's
     angles are in the driver's frame: roadgaze.pose.mounting); None: the same as the neutral."""
+    outputs: tuple[Output, ...] = ()
+    """The monitor behaviours' per-frame outputs that are not alerts (roadgaze.monitor.events
+    `Publish`), in the order the behaviours ran; none today."""
 
     @property
     def eyes_on_road(self) -> bool | None:

@@ -1,7 +1,8 @@
 """Inattention monitor: glance zones and a pure time-based state machine, samples to verdicts."""
 
 from roadgaze.monitor.eye_rules import classify_eyes, eye_zone_map, gaze_deg, soft_threshold
-from roadgaze.monitor.eyes import EyeMonitorState, step_eyes
+from roadgaze.monitor.eyes import EyeMonitorState
+from roadgaze.monitor.eyes_alone import step_eyes
 from roadgaze.monitor.inattention import Monitor, step, verdict_of
 from roadgaze.monitor.state import MonitorState, distraction_s, initial_state
 from roadgaze.monitor.zones import (

@@ -177,8 +177,7 @@ def measure_eyes(
     if open_on_road and steady and dt > 0 and eyes is not None:
         learned = _learn_rest(config, state, eyes, mp_pitch, dt)
     unavailable_since, degraded = _unavailable(config, state, status, moving, t)
-    new_state = replace(
-        learned,
+    measured = EyeMonitorState(
         t_s=t,
         status=status,
         reason=reason,
@@ -186,11 +185,15 @@ def measure_eyes(
         closure_since_s=closure_since,
         blinks=blinks,
         bins=bins,
+        road_pitch_deg=learned.road_pitch_deg,
+        calibration=learned.calibration,
+        learned_s=learned.learned_s,
+        open_baseline=learned.open_baseline,
         unavailable_since_s=unavailable_since,
         degraded=degraded,
     )
-    verdict = _verdict(config, new_state, eyes, head_yaw_deg, head_pitch_deg)
-    return replace(new_state, verdict=verdict)
+    verdict = _verdict(config, measured, eyes, head_yaw_deg, head_pitch_deg)
+    return replace(measured, verdict=verdict)
 
 
 def _judge(

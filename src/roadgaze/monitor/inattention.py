@@ -35,8 +35,9 @@ Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monit
   to `driving_glance_max_s` per continuous stay when that is set; ADDW's area 1 never is); level
   warning, raised to critical `critical_after_warning_s` later (not before
   `critical_distraction_s`).
-- `temporary_failure` (roadgaze.monitor.failures): blocked, black, saturated or frozen frames,
-  no judgeable face, unjudgeable eyes, each for its time while moving; cleared once recovered.
+- `temporary_failure` (roadgaze.monitor.failures, .behaviours.temporary_failure): blocked,
+  black, saturated or frozen frames, no judgeable face, unjudgeable eyes, each for its time while
+  moving; cleared once recovered.
 - `vats` (Euro NCAP only): off-road time (every zone but road) within the last `vats_window_s`
   reaches `vats_threshold_s`; fires once and is re-armed after `vats_rearm_s` continuously on
   road.
@@ -49,8 +50,8 @@ Definitions (thresholds from `MonitorConfig`; defaults and sources in docs/monit
   driving-related zones) `unresponsive_away_s`, or not back on the road
   `unresponsive_after_warning_s` after a `long_distraction` or `vats` warning.
 - `cleared`: on the road with a face and eyes not closed for `clear_on_road_s` after any
-  distraction alert; a closure's alerts once the eyes are open on the road again; `drowsy` once
-  re-armed; `degraded` once the eyes are back.
+  distraction alert; a closure's alerts once the eyes are open and back on the road (the same
+  time); `drowsy` once re-armed; `degraded` once the eyes are back.
 - speed gating: time off road or unavailable counts only while a configured protocol is active
   (ADDW above `addw_min_speed_kmh`, Euro NCAP above `min_speed_kmh`; `speed_kmh` None means
   unknown and is taken as moving, in the highest band), so no alert fires below that speed.

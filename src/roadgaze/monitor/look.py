@@ -101,9 +101,11 @@ def classify(
     eyes: EyesVerdict,
 ) -> Look:
     """Where the driver looks at `sample` (in the driver's frame), after `previous`."""
-    look = _judge(config, zones, previous, neutral, sample, eyes)
-    last_yaw = look.yaw_deg if look.yaw_deg is not None else previous.last_face_yaw_deg
-    return replace(look, last_face_yaw_deg=last_yaw)
+    gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes = _judge(
+        config, zones, previous, neutral, sample, eyes
+    )
+    last_yaw = yaw if yaw is not None else previous.last_face_yaw_deg
+    return Look(gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes, last_yaw)
 
 
 def _judge(
@@ -113,7 +115,8 @@ def _judge(
     neutral: NeutralPose,
     sample: PoseSample,
     eyes: EyesVerdict,
-) -> Look:
+) -> tuple[Gaze, str | None, str, float | None, float | None, float | None, bool, bool]:
+    """Gaze, zone, face zone, yaw, pitch, face lost since, turned away, judged by the eyes."""
     t_s = sample.t_s
     yaw = finite(sample.yaw_deg, sample.yaw_raw_deg) if sample.face else None
     pitch = finite(sample.pitch_deg, sample.pitch_raw_deg) if sample.face else None
@@ -142,9 +145,9 @@ def _judge(
                     excused_head or not zones.is_driving_related(gaze_zone)
                 ):
                     gaze = Gaze.ON_ROAD if gaze_zone == ROAD else Gaze.OFF_ROAD
-                    return Look(gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, by_eyes=True)
+                    return gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, True
         gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
-        return Look(gaze, zone, zone, yaw, pitch, None, False)
+        return gaze, zone, zone, yaw, pitch, None, False, False
     if previous.lost_since_s is not None:
         lost_since, turned = previous.lost_since_s, previous.turned_away
     else:
@@ -154,8 +157,8 @@ def _judge(
         else:
             turned = abs(previous.last_face_yaw_deg - neutral.yaw_deg) > config.turn_away_deg
     if not turned:
-        return Look(Gaze.UNKNOWN, None, previous.face_zone, None, None, lost_since, False)
+        return Gaze.UNKNOWN, None, previous.face_zone, None, None, lost_since, False, False
     zone = previous.face_zone
     if zone == ROAD or zones.is_driving_related(zone):  # out of view: no longer a mirror glance
         zone = AWAY
-    return Look(Gaze.OFF_ROAD, zone, zone, None, None, lost_since, True)
+    return Gaze.OFF_ROAD, zone, zone, None, None, lost_since, True, False

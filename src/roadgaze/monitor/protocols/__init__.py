@@ -74,6 +74,7 @@ TABLE: tuple[tuple[str, Behaviour[Any]], ...] = (
 configured protocols' triggers (`distraction_trigger`), the eye rules cite Euro NCAP's rows."""
 
 
+@cache
 def configured(protocol: str) -> frozenset[str]:
     """The protocols `[monitor] protocol` (`addw`, `euroncap` or `both`) stands for."""
     return frozenset({"addw", "euroncap"} if protocol == "both" else {protocol})

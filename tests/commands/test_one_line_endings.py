@@ -84,7 +84,7 @@ def test_batch_on_a_ray_address_with_nothing_there_fails_in_bounded_time(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Ray's own connect retries for minutes (measured past 240 s): the head is probed first."""
-    import roadgaze.fleet.executors as executors
+    import roadgaze.fleet.engines as engines
 
     class NoRay:  # ray.init must never be reached: nothing listens at the address
         @staticmethod
@@ -95,12 +95,12 @@ def test_batch_on_a_ray_address_with_nothing_there_fails_in_bounded_time(
         def init(**options: object) -> None:
             raise AssertionError("ray.init called")
 
-    monkeypatch.setattr(executors, "import_ray", lambda: NoRay)
+    monkeypatch.setattr(engines, "import_ray", lambda: NoRay)
     address = f"ray://127.0.0.1:{free_port()}"
-    executor = executors.RayExecutor(tmp_path / "batch.log", address, timeout_s=1.0)
+    engine = engines.RayEngine(tmp_path / "batch.log", address, timeout_s=1.0)
     started = time.monotonic()
     with pytest.raises(ConfigError, match=rf"no Ray cluster at {address}: nothing accepted"):
-        executor.__enter__()
+        engine.__enter__()
     assert time.monotonic() - started < 5.0
     assert ray_head_endpoint("10.0.0.5:6379") == ("10.0.0.5", 6379)
     assert ray_head_endpoint("auto") is None

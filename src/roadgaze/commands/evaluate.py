@@ -103,6 +103,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.evaluation.pointing04 import DATA_ENV, default_dataset
     from roadgaze.landmarks import CANDIDATE_CHOICES
     from roadgaze.landmarks.model_store import resolve_model
+    from roadgaze.pose.geometry import FaceModelConstants
 
     if args.task == "phone":
         from roadgaze.commands.evaluate_phone import run_phone
@@ -135,7 +136,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
             f"none of the {len(truths)} images listed in {args.dataset / 'ground_truth.csv'} "
             f"exists under {args.dataset} (first: {truths[0].file}); check the folder"
         )
-    constants = config.geometry.face_constants()
+    constants = FaceModelConstants.from_config(config.geometry)
     model_path = resolve_model(config.model)
     if args.condition:
         return run_conditions(args, config, truths, model_path)

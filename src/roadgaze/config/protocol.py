@@ -6,14 +6,11 @@ source is in its table (`roadgaze.monitor.protocols`) and in docs/monitor.md.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
 from pydantic import Field, model_validator
 
 from roadgaze.config.section import Section
-
-if TYPE_CHECKING:
-    from roadgaze.pose.mounting import CameraMounting
 
 AREA1_ZONE_NAMES = ("far_left", "far_right", "roof")
 """The zones of ADDW's distraction area 1 (roadgaze.monitor.zones): reserved names."""
@@ -51,7 +48,7 @@ class ProtocolSettings(Section):
     on-road sample)."""
 
     camera_mounting: MountingName = "front"
-    """Where the camera sits (roadgaze.pose.mounting): head pose and gaze are mapped into the
+    """Where the camera sits (roadgaze.mounting): head pose and gaze are mapped into the
     driver's frame before zones, the neutral and alerts."""
     cabin: Literal["lhd", "rhd"] = "lhd"
     """Left- or right-hand drive: mirrors the mounting preset and the default zones."""
@@ -98,15 +95,3 @@ class ProtocolSettings(Section):
                 f"addw_distraction_low_s ({self.addw_distraction_low_s:g}): faster warns sooner"
             )
         return self
-
-    def mounting(self) -> CameraMounting:
-        """The camera mounting: the preset in this cabin, with any explicit angles."""
-        from roadgaze.pose.mounting import mounting_for
-
-        return mounting_for(
-            self.camera_mounting,
-            self.cabin,
-            self.camera_yaw_deg,
-            self.camera_pitch_deg,
-            self.camera_roll_deg,
-        )

@@ -1,7 +1,7 @@
 """A scenario as a recorded drive: its frames, `NAME.speed.csv`, `NAME.truth.csv` (`NAME.mkv`).
 
 The head pose and eyes of the scenario (driver's frame) go through the camera mounting
-(`roadgaze.pose.mounting.head_to_camera`) and are rendered as that camera sees the face; sensor
+(`roadgaze.mounting.head_to_camera`) and are rendered as that camera sees the face; sensor
 noise goes on every frame (a held pose is not a frozen camera), sunglasses over the eyes when the
 scenario wears them. A covered lens is a dark flat frame, no face the cabin without the driver,
 frozen frames the last frame again, byte for byte. `RenderedSource` hands the frames to the loop
@@ -22,7 +22,7 @@ import numpy as np
 
 from roadgaze.capture.base import SourceBase, SourceInfo, SourceStatus
 from roadgaze.conformance.model import CameraState, Scenario
-from roadgaze.pose.mounting import Cabin, head_to_camera, mounting_for
+from roadgaze.mounting import Cabin, head_to_camera, mounting_for
 from roadgaze.synth.clip import write_truth_csv
 from roadgaze.synth.effects import NoiseBank, covered_frame, sunglasses
 from roadgaze.synth.eyes import EyeRenderer, EyeState

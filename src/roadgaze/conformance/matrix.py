@@ -13,6 +13,7 @@ from roadgaze.config import MonitorConfig
 from roadgaze.conformance import expect
 from roadgaze.conformance.model import Requirement, Scenario, Segment
 from roadgaze.monitor.protocols import addw
+from roadgaze.monitor.zones import ZoneMap
 
 AHEAD_S = 3.0
 """Looking at the road first: the neutral's running mean settles within a second or two."""
@@ -52,7 +53,7 @@ def back() -> Segment:
 def zone_target(config: MonitorConfig, name: str) -> tuple[float, float]:
     """The centre of zone `name`'s rectangle (yaw within ADDW's area, pitch within what the
     renderer shows), relative to the neutral, in degrees."""
-    zone = next(z for z in config.zone_map().zones if z.name == name)
+    zone = next(z for z in ZoneMap.from_config(config).zones if z.name == name)
     limit = config.distraction_yaw_deg - 5.0
     yaw_min, yaw_max = max(zone.yaw_min_deg, -limit), min(zone.yaw_max_deg, limit)
     pitch_min = max(zone.pitch_min_deg, PITCH_LIMITS_DEG[0])

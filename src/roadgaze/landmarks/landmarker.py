@@ -172,8 +172,9 @@ class Landmarker(ClosesOnExit):
     def from_config(cls, config: Config, video: bool = False) -> Landmarker:
         """A landmarker with the model from `resolve_model` (fetched on first use if allowed)."""
         from roadgaze.landmarks.model_store import resolve_model
+        from roadgaze.mounting import CameraMounting
 
-        mounting = config.monitor.mounting()
+        mounting = CameraMounting.from_config(config.monitor)
         angles = (mounting.yaw_deg, mounting.pitch_deg, mounting.roll_deg)
         side = driver_image_side(config.monitor.cabin, *angles)
         return cls(config.landmarks, resolve_model(config.model), video=video, seat_side=side)

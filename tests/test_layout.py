@@ -27,6 +27,7 @@ PURE_MODULES = (
     "roadgaze.transport.messages",
     "roadgaze.transport.keys",
     "roadgaze.transport.speed",
+    "roadgaze.speed",
     "roadgaze.transport.vss",
     "roadgaze.landmarks.features",
     "roadgaze.landmarks.driver",

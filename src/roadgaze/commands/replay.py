@@ -207,7 +207,11 @@ def run(args: argparse.Namespace, config: Config) -> int:
         require_foxglove("--mcap")
     config = with_zenoh_args(config, args)
     speed_choice = recorded_speed(
-        args.source, args.speed_track, args.speed_kmh, config.zenoh.speed_timeout_s
+        args.source,
+        args.speed_track,
+        args.speed_kmh,
+        config.zenoh.speed_timeout_s,
+        max_rows=config.capture.speed_track_max_rows,
     )
     stats = ReplayStats()
     with ExitStack() as stack:

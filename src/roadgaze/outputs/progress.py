@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from roadgaze.types import ClosesOnExit, Frame, FrameRecord
+from roadgaze.types import ClosesOnExit, Frame, FrameRecord, Sink
 
 
-class ProgressBar(ClosesOnExit):
+class ProgressBar(ClosesOnExit, Sink):
     """A tqdm progress bar on stderr (frames, fps, ETA) as a sink."""
 
     def __init__(self, total: int | None, description: str = "replay") -> None:

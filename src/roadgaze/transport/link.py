@@ -249,13 +249,14 @@ class ZenohLink:
         if not self.undelivered()[0]:
             time.sleep(RECOVERY_GRACE_S)
 
-    def stop_ledger(self) -> None:
-        """At exit: alerts still waiting for a link (or a session) are gone."""
-        self.link_state.stopped()
+    def stop_ledger(self, ending: str = "the daemon stopped") -> None:
+        """At exit: alerts still waiting for a link (or a session) are gone; `ending` says what
+        ended (`the replay ended`)."""
+        self.link_state.stopped(f"never delivered: no link when {ending}")
         with self._lock:
             pending, self._pending = list(self._pending), deque(maxlen=self._pending.maxlen)
         for _, alert in pending:
-            self.link_state.gone(alert, "never published: no zenoh session when the daemon stopped")
+            self.link_state.gone(alert, f"never published: no zenoh session when {ending}")
 
     def status(self) -> TransportStatus:
         with self._lock:

@@ -3,9 +3,10 @@ protocols' active speed (`[monitor] min_speed_kmh`, `addw_min_speed_kmh`) stops 
 timers, so no alert fires while it lasts (an unknown speed never does: it counts as moving).
 
 `SpeedGateLog` is a sink that logs when that starts and when it stops, on the drive's own time:
-the first change at once, then at most one line per `period_s` seconds of the drive, which says
-the state at that time and how many changes it sums up; at the end, how long alerts were held
-back in all.
+a start at most once per `period_s` seconds of the drive (a flapping speed around the threshold
+is summed up: the next line says how many changes it stands for), and the stop of every start
+logged, so the last line always tells the state; at the end, how long alerts were held back in
+all.
 """
 
 from __future__ import annotations
@@ -32,10 +33,11 @@ class SpeedGateLog(Sink):
         self.held_s = 0.0
         """Seconds of the drive with alerts held back, up to the last record."""
         self.times_held = 0
-        self._since_s = 0.0
+        self._said_holding = False
         self._last_t_s: float | None = None
-        self._logged_s = -math.inf
+        self._said_s = -math.inf
         self._changes = 0
+        """Changes since the last line."""
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         verdict, t_s = record.verdict, record.t_s
@@ -46,8 +48,11 @@ class SpeedGateLog(Sink):
             self.holding = not verdict.moving
             self.times_held += self.holding
             self._changes += 1
-        if self._changes and t_s - self._logged_s >= self.period_s:
-            self._say(t_s, verdict.speed_kmh)
+        if self.holding == self._said_holding:
+            return
+        if self.holding and t_s - self._said_s < self.period_s:
+            return  # a start within the period: said later, if it still holds then
+        self._say(t_s, verdict.speed_kmh)
 
     def _say(self, t_s: float, speed_kmh: float | None) -> None:
         more = self._changes - 1
@@ -66,7 +71,9 @@ class SpeedGateLog(Sink):
             what,
             since,
         )
-        self._logged_s, self._changes = t_s, 0
+        self._said_holding, self._changes = self.holding, 0
+        if self.holding:
+            self._said_s = t_s
 
     def close(self) -> None:
         if self.times_held:

@@ -8,6 +8,7 @@ show, e.g. a bind mount).
 
 from __future__ import annotations
 
+import fnmatch
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -30,25 +31,26 @@ def same_file(first: PathLike, second: PathLike) -> bool:
     return (one.st_dev, one.st_ino) == (other.st_dev, other.st_ino)
 
 
-def inside(path: PathLike, folder: PathLike) -> bool:
-    """True when `path` is in `folder` or below it (real paths)."""
+def in_folder(path: PathLike, folder: PathLike, pattern: str) -> bool:
+    """True when `path` is in `folder` (real paths) with a name matching `pattern` (fnmatch)."""
     try:
         real, top = Path(path).resolve(), Path(folder).resolve()
     except (OSError, ValueError, RuntimeError):
         return False
-    return real != top and real.is_relative_to(top)
+    return real.parent == top and fnmatch.fnmatch(real.name, pattern)
 
 
 def check_output_paths(
     inputs: Mapping[str, PathLike | None],
     outputs: Mapping[str, PathLike | None],
     suffixes: Mapping[str, tuple[str, ...]] | None = None,
-    folders: Mapping[str, PathLike | None] | None = None,
+    folders: Mapping[str, tuple[PathLike | None, str]] | None = None,
 ) -> None:
     """Refuse, before anything is written, an output that is an input (it would destroy it),
-    an output folder holding an input (its old files are pruned), two outputs on one file
-    (they would mix formats) and an output whose file type its writer cannot write. Keys are
-    the names used in the message (an option, or what the input is); '-' is stdout, None none.
+    an input that an output folder's writer may remove or rename (`folders`: name -> (folder,
+    the fnmatch pattern of the files it manages)), two outputs on one file (they would mix
+    formats) and an output whose file type its writer cannot write. Keys are the names used in
+    the message (an option, or what the input is); '-' is stdout, None none.
     """
     read = {name: Path(path) for name, path in inputs.items() if path not in (None, "-")}
     given = {name: Path(path) for name, path in outputs.items() if path not in (None, "-")}
@@ -65,12 +67,13 @@ def check_output_paths(
                     f"{name} {path} is the input ({input_name}): it would be overwritten; "
                     "choose another output path"
                 )
-    for name, folder in (folders or {}).items():
+    for name, (folder, pattern) in (folders or {}).items():
         for input_name, input_path in read.items():
-            if folder is not None and inside(input_path, folder):
+            if folder is not None and in_folder(input_path, folder, pattern):
                 raise ConfigError(
-                    f"{name} {folder} holds the input {input_path} ({input_name}): a recording "
-                    "there is pruned to its size limit; choose another folder"
+                    f"{name} {folder} would prune or recover the input {input_path} "
+                    f"({input_name}): it is named as one of its files ({pattern}); "
+                    "choose another folder"
                 )
     names = list(given)
     for index, name in enumerate(names):

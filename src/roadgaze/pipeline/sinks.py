@@ -20,8 +20,9 @@ if TYPE_CHECKING:
 
 def check_paths(config: Config, options: RunOptions, choice: SpeedChoice) -> None:
     """Refuse (one `ConfigError`, before anything is written) an output onto a file the run
-    reads, an output folder holding one, two outputs on one file, or a file type its writer
-    cannot write (`roadgaze.outputs.paths`)."""
+    reads, an input named as one of the `--record` folder's segments (pruned or recovered
+    there), two outputs on one file, or a file type its writer cannot write
+    (`roadgaze.outputs.paths`)."""
     from roadgaze.outputs.paths import PLOT_SUFFIXES, check_output_paths
     from roadgaze.outputs.video import FOURCC_BY_SUFFIX
 
@@ -44,8 +45,17 @@ def check_paths(config: Config, options: RunOptions, choice: SpeedChoice) -> Non
             "--mcap": options.mcap,
         },
         {"--plot": PLOT_SUFFIXES, "--annotate": tuple(FOURCC_BY_SUFFIX), "--mcap": (".mcap",)},
-        {"--record": options.record_dir},
+        {"--record": (options.record_dir, segment_pattern(config, options))},
     )
+
+
+def segment_pattern(config: Config, options: RunOptions) -> str:
+    """The names of the segments `--record` writes, rotates, prunes and recovers."""
+    if options.record_dir is None:
+        return ""
+    from roadgaze.outputs.foxglove.open import segment_prefix  # needs roadgaze[foxglove]
+
+    return f"{segment_prefix(config)}-*.mcap*"
 
 
 def recorders(

@@ -28,6 +28,7 @@ PURE_MODULES = (
     "roadgaze.transport.messages",
     "roadgaze.transport.keys",
     "roadgaze.transport.speed",
+    "roadgaze.speed",
     "roadgaze.transport.vss",
     "roadgaze.landmarks.features",
     "roadgaze.landmarks.driver",
@@ -49,7 +50,18 @@ MAX_FOLD_LINES = 60
 """The monitor's own step (`roadgaze.monitor.inattention.step`): a fold over the behaviours."""
 MAX_MONITOR_FUNCTION_LINES = 80
 STAGES: tuple[tuple[str, ...], ...] = (
-    ("errors", "eye_records", "types", "logs", "csv_rows", "config", "mounting", "hand_records"),
+    (
+        "errors",
+        "eye_records",
+        "types",
+        "logs",
+        "csv_rows",
+        "config",
+        "mounting",
+        "hand_records",
+        "threads",
+    ),
+    ("speed",),
     ("capture",),
     ("landmarks",),
     ("pose", "geometry"),
@@ -68,16 +80,12 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("__main__",),
 )
 """The order of the package's top-level modules and folders: the pipeline's stages (capture ->
-landmarks -> pose -> phone (the judgement over hands, face and head pose) -> monitor -> transport and outputs -> pipeline -> service), after the
-vocabulary every stage shares, then the tools around the service and the command line. Each
-imports only from its own stage and earlier ones. `geometry` is the old path of pose.geometry."""
-KNOWN_UPWARD: dict[tuple[str, str], str] = {
-    # TODO issue 31 part 2: one vehicle-speed module; the speed track reader leaves capture.
-    ("capture/speed_track.py", "pipeline"): "issue 31 part 2",
-    # TODO: lower_this_thread_priority belongs before both (pipeline.steps and the recorder's
-    # image thread use it); moved once the branches that edit both files are merged.
-    ("outputs/foxglove/recorder.py", "pipeline"): "thread priority helper",
-}
+landmarks -> pose -> phone (the judgement over hands, face and head pose) -> monitor ->
+transport and outputs -> pipeline -> service), after the vocabulary every stage shares, then the
+tools around the service and the command line. Each imports only from its own stage and earlier
+ones. `speed` (the vehicle's speed: tracks, bus values, the one range check) comes before capture,
+which reads a drive's track beside its video. `geometry` is the old path of pose.geometry."""
+KNOWN_UPWARD: dict[tuple[str, str], str] = {}
 """Imports from a stage to a later one that are known and owned: (file under roadgaze/, the
 later unit) -> why it is still here."""
 FOLDERS = sorted(p for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").is_file())

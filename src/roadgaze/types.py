@@ -367,3 +367,23 @@ class ClosesOnExit:
         traceback: TracebackType | None,
     ) -> None:
         self.close()
+
+
+class Sink(Protocol):
+    """Where a run's results go: every frame record in order (`on_record`), every alert raised
+    outside the frame loop (`on_alert`: a camera gone for good, a model that cannot be loaded,
+    when no frame comes to carry it) and `close()` once at the end.
+
+    Subclass it to inherit the no-op `on_alert` of a sink with nothing to do with such an alert
+    (a progress bar); a sink that keeps, sends or counts alerts implements it. `on_alert` may be
+    called from another thread, never during another call to the same run's sinks
+    (`roadgaze.pipeline.build_run` holds one lock around both).
+    """
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None: ...
+
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop; by default nothing to do."""
+        del alert
+
+    def close(self) -> None: ...

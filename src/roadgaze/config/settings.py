@@ -113,7 +113,7 @@ class LandmarksConfig(_Section):
 
 
 class CaptureConfig(_Section):
-    """Camera settings (ignored for files)."""
+    """Camera settings (ignored for files), and the size of a speed track read."""
 
     width: int = Field(default=640, gt=0)
     height: int = Field(default=480, gt=0)
@@ -121,6 +121,8 @@ class CaptureConfig(_Section):
     fourcc: str = Field(default="MJPG", min_length=4, max_length=4)
     reconnect_initial_s: float = Field(default=0.5, gt=0)
     reconnect_max_s: float = Field(default=10.0, gt=0)
+    speed_track_max_rows: int = Field(default=2_000_000, gt=0)
+    """Most rows of a speed track read (roadgaze.speed: 16 bytes each); a longer one is refused."""
 
 
 class SmoothingConfig(_Section):

@@ -79,6 +79,10 @@ class Health:
         for alert in record.alerts:
             self.note_alert(alert)
 
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop: counted and logged like the others."""
+        self.note_alert(alert)
+
     def note_alert(self, alert: Alert) -> None:
         """Count and log one alert (from a record, or raised outside the loop)."""
         message = AlertMessage.from_alert(

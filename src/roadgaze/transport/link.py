@@ -249,10 +249,11 @@ class ZenohLink:
                 return
             time.sleep(0.05)
 
-    def stop_ledger(self) -> None:
+    def stop_ledger(self, ending: str = "the daemon stopped") -> None:
         """At exit: alerts still waiting for a link (or a session, or a first subscriber) are
-        gone; those left on a bus whose subscribers have gone are named in a warning."""
-        left = self.link_state.stopped()
+        gone; those left on a bus whose subscribers have gone are named in a warning. `ending`
+        says what ended (`the replay ended`)."""
+        left = self.link_state.stopped(ending)
         if left:
             log.warning(
                 "%d alert%s published after the last subscriber left stay%s on the bus, not "
@@ -266,7 +267,7 @@ class ZenohLink:
         with self._lock:
             pending, self._pending = list(self._pending), deque(maxlen=self._pending.maxlen)
         for _, alert in pending:
-            self.link_state.gone(alert, "never published: no zenoh session when the daemon stopped")
+            self.link_state.gone(alert, f"never published: no zenoh session when {ending}")
 
     def status(self) -> TransportStatus:
         with self._lock:

@@ -192,20 +192,21 @@ class LinkState:
         with self._lock:
             self.ledger.gone(alert, why)
 
-    def stopped(self) -> list[str]:
+    def stopped(self, ending: str = "the daemon stopped") -> list[str]:
         """At exit: alerts still waiting are gone (no link, no subscriber during the whole run,
         or one that had no time to fetch them); on a live bus whose subscribers have left they
-        stay on it: their names are returned."""
+        stay on it: their names are returned. `ending` says what ended (`the replay ended`)."""
         with self._lock:
             self.ledger.confirm(self._available_s(), self._clock())
             if self._up_since is None:
-                why = "never delivered: no link when the daemon stopped"
+                why = f"never delivered: no link when {ending}"
             elif self._matched_since is not None:
-                why = "perhaps never delivered: a subscriber had just come when the daemon stopped"
+                why = f"perhaps never delivered: a subscriber had just come when {ending}"
             elif self.ever_matched:
                 return self.ledger.release()
             else:
-                why = "never delivered: no subscriber came to the bus while the daemon ran"
+                who = "the replay" if "replay" in ending else "the daemon"
+                why = f"never delivered: no subscriber came to the bus while {who} ran"
             self.ledger.stopped(why)
             return []
 

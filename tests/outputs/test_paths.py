@@ -44,3 +44,24 @@ def test_two_outputs_on_one_file_and_a_type_no_writer_writes(tmp_path: Path) -> 
     with pytest.raises(ConfigError, match=r"--plot .*: cannot write a \.txt file"):
         check_output_paths({}, {"--plot": tmp_path / "p.txt"}, {"--plot": (".png",)})
     check_output_paths({"the source": "-"}, {"--out": "-", "--csv": None})  # stdout, none
+
+
+@pytest.mark.parametrize("kind", ["device", "fifo", "folder"])
+def test_an_output_that_is_no_regular_file_is_refused_before_anything_runs(
+    tmp_path: Path, kind: str
+) -> None:
+    """`replay --out /dev/null` used to replace /dev/null with a regular file (the offline pass
+    writes a temporary file and renames it over the output)."""
+    import os
+
+    if kind == "device":
+        target = Path("/dev/null")
+    elif kind == "fifo":
+        target = tmp_path / "pipe"
+        os.mkfifo(target)
+    else:
+        target = tmp_path / "folder"
+        target.mkdir()
+    with pytest.raises(ConfigError, match=r"--out .* is not a regular file"):
+        check_output_paths({}, {"--out": target})
+    assert kind != "device" or not target.is_file()

@@ -31,6 +31,13 @@ def same_file(first: PathLike, second: PathLike) -> bool:
     return (one.st_dev, one.st_ino) == (other.st_dev, other.st_ino)
 
 
+def _exists_but_not_a_file(path: Path) -> bool:
+    try:
+        return path.exists() and not path.is_file()
+    except (OSError, ValueError):
+        return False
+
+
 def in_folder(path: PathLike, folder: PathLike, pattern: str) -> bool:
     """True when `path` is in `folder` (real paths) with a name matching `pattern` (fnmatch)."""
     try:
@@ -49,12 +56,19 @@ def check_output_paths(
     """Refuse, before anything is written, an output that is an input (it would destroy it),
     an input that an output folder's writer may remove or rename (`folders`: name -> (folder,
     the fnmatch pattern of the files it manages)), two outputs on one file (they would mix
-    formats) and an output whose file type its writer cannot write. Keys are the names used in
+    formats), an output that exists but is no regular file (`/dev/null` would be replaced by a
+    file) and an output whose file type its writer cannot write. Keys are the names used in
     the message (an option, or what the input is); '-' is stdout, None none.
     """
     read = {name: Path(path) for name, path in inputs.items() if path not in (None, "-")}
     given = {name: Path(path) for name, path in outputs.items() if path not in (None, "-")}
     for name, path in given.items():
+        if _exists_but_not_a_file(path):
+            raise ConfigError(
+                f"{name} {path} is not a regular file (a device, a pipe or a folder): outputs "
+                "are written as files and completed in place (e.g. the offline columns are "
+                "read back); give a file path, or '-' for stdout where the option takes it"
+            )
         allowed = (suffixes or {}).get(name)
         if allowed and path.suffix.lower() not in allowed:
             raise ConfigError(

@@ -588,8 +588,7 @@ def test_run_and_listen_without_endpoint_flags_find_each_other(with_router: bool
             stdout, listen_log = listener.communicate(timeout=60)
             daemon.send_signal(signal.SIGTERM)
             assert daemon.wait(timeout=30) == 0
-            while (line := daemon_log.next(1.0)) is not None:
-                lines.append(line)
+            lines += daemon_log.rest()
         finally:
             stop_process(daemon)
             if listener is not None:

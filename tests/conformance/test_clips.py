@@ -57,9 +57,19 @@ def test_a_preset_renders_the_face_as_its_camera_sees_it(renderer: ScenarioRende
     frame = next(renderer.frames(scenario)).astype(np.float64)
     yaw, pitch, _ = head_to_camera(mounting_for("a_pillar"), 0.0, -35.0)
     assert yaw < -20.0  # the camera on the left pillar sees the face turned to its right
-    seen = renderer.renderer.render_eyes(yaw, pitch, EyeState()).astype(np.float64)
-    front = renderer.renderer.render_eyes(0.0, -35.0, EyeState()).astype(np.float64)
+    facing = renderer.facing_pitch_deg
+    seen = renderer.renderer.render_eyes(yaw, pitch + facing, EyeState()).astype(np.float64)
+    front = renderer.renderer.render_eyes(0.0, -35.0 + facing, EyeState()).astype(np.float64)
     assert np.abs(frame - seen).mean() < 3.0 < np.abs(frame - front).mean()
+
+
+def test_the_road_pose_faces_the_camera(renderer: ScenarioRenderer) -> None:
+    """The photo's face looks 11.5 deg below its camera; a scenario looking at the road with the
+    camera in front is rendered facing the lens."""
+    assert renderer.facing_pitch_deg == pytest.approx(11.5, abs=0.5)
+    frame = next(renderer.frames(Scenario("road", "", (Segment(0.2),), 70.0, ())))
+    faced = renderer.renderer.render_eyes(0.0, renderer.facing_pitch_deg, EyeState())
+    assert np.abs(frame.astype(np.float64) - faced.astype(np.float64)).mean() < 3.0
 
 
 def test_sunglasses_cover_the_eyes(renderer: ScenarioRenderer) -> None:
@@ -140,3 +150,35 @@ def replace_conditions(scenario: Scenario, conditions: tuple[str, ...]) -> Scena
     from dataclasses import replace
 
     return replace(scenario, conditions=conditions)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("scenario_name", "condition"),
+    [
+        ("microsleep_70", "night"),
+        ("microsleep_70", "clear_sunglasses"),
+        ("side_left_70", "stubble"),
+        ("microsleep_70", "talking"),
+    ],
+)
+def test_a_green_scenario_still_passes_under_a_noise_variable(
+    tmp_path: Path, scenario_name: str, condition: str
+) -> None:
+    """The real service (MediaPipe, the pipeline, the monitor) on the drive rendered under the
+    condition, as the dossier runs it: every requirement still PASS."""
+    from roadgaze.config import Config
+    from roadgaze.conformance.dossier_rows import under
+    from roadgaze.conformance.matrix import scenario_matrix
+    from roadgaze.conformance.run import run_suite
+    from roadgaze.synth import EyeRenderer, load_photo
+
+    config = Config()
+    monitor = config.monitor.model_dump() | {"protocol": "euroncap"}
+    config = config.model_copy(update={"monitor": type(config.monitor).model_validate(monitor)})
+    scenario = next(s for s in scenario_matrix(config.monitor) if s.name == scenario_name)
+    eyes = EyeRenderer(load_photo(), (320, 320), config=config, eyeball_at_rest=True)
+    suite = run_suite([under(condition)(scenario)], config, tmp_path, ScenarioRenderer(eyes, 15.0))
+    assert suite.outcomes and all(o.result == "PASS" for o in suite.outcomes), [
+        (o.requirement.key, o.measured_s, o.alerts) for o in suite.outcomes
+    ]

@@ -1,7 +1,9 @@
 """A scenario as a recorded drive: its frames, `NAME.speed.csv`, `NAME.truth.csv` (`NAME.mkv`).
 
 The head pose and eyes of the scenario (driver's frame) go through the camera mounting
-(`roadgaze.pose.mounting.head_to_camera`) and are rendered as that camera sees the face, dressed
+(`roadgaze.pose.mounting.head_to_camera`) and are rendered as that camera sees the face (a head
+pose of 0, 0 in the camera's frame faces the lens: the photo's own downward look,
+`HeadFrame.facing_pitch_deg`, is nodded away), dressed
 in what the scenario's `conditions` name (`roadgaze.synth.outfit`: glasses, a mask, a beard, a
 cap, ...), the jaw moving with speech when it is `talking`, a hand on the wheel where the camera
 sees it (`hand_at_12`); sensor noise goes on every frame (a held pose is not a frozen camera),
@@ -29,6 +31,7 @@ from roadgaze.pose.mounting import Cabin, head_to_camera, mounting_for
 from roadgaze.synth.clip import write_truth_csv
 from roadgaze.synth.effects import NoiseBank, covered_frame, night
 from roadgaze.synth.eyes import EyeRenderer, EyeState
+from roadgaze.synth.head import HeadFrame
 from roadgaze.synth.mouth import speech_track
 from roadgaze.synth.occluders import hand_at_12
 from roadgaze.synth.outfit import WORN, Outfit, check_conditions
@@ -79,6 +82,8 @@ class ScenarioRenderer:
         self.renderer = renderer
         self.fps = fps
         self.cabin = cabin
+        self.facing_pitch_deg = HeadFrame.of(renderer).facing_pitch_deg
+        """Added to every rendered pitch: the photo's face looks this far below its camera."""
         self._outfits: dict[tuple[str, ...], Outfit] = {}
 
     def outfit(self, conditions: tuple[str, ...]) -> Outfit:
@@ -96,14 +101,17 @@ class ScenarioRenderer:
         cache: dict[tuple[float, ...], ImageBGR],
     ) -> ImageBGR:
         mounting = mounting_for(scenario.mounting, self.cabin)
-        yaw, pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
+        yaw, camera_pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
+        pitch = camera_pitch + self.facing_pitch_deg
         key = tuple(round(float(v), 4) for v in (yaw, pitch, *row[3:6], mouth_open))
         if key not in cache:
             outfit = self.outfit(scenario.conditions)
             state = EyeState.both(float(row[3]), float(row[4]), float(row[5]))
             frame = outfit.render(yaw, pitch, state, mouth_open)
             if "hand_at_12" in scenario.conditions:
-                frame = hand_at_12(frame, outfit.renderer, scenario.mounting, self.cabin)
+                road_yaw, road_pitch, _ = head_to_camera(mounting, 0.0, 0.0)
+                rest = (road_yaw, road_pitch + self.facing_pitch_deg)
+                frame = hand_at_12(frame, outfit.renderer, scenario.mounting, self.cabin, rest)
             cache[key] = frame
         return cache[key]
 

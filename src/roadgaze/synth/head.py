@@ -11,6 +11,7 @@ mesh is (`FaceRenderer.turned_points`), so everything worn follows the turned fa
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,6 +56,13 @@ class HeadFrame:
         offsets = np.asarray(offsets_w, dtype=np.float64).reshape(-1, 3) * self.width_px
         axes = np.vstack([self.right, self.up, self.forward])
         return np.asarray(anchor + offsets @ axes, dtype=np.float64)
+
+    @property
+    def facing_pitch_deg(self) -> float:
+        """How far the photo's face looks down from the camera (degrees, > 0 = down): the nod up
+        that turns it to face the lens (the astronaut's: 11.5, where MediaPipe's matrix pitch
+        reads 0)."""
+        return math.degrees(math.asin(max(-1.0, min(1.0, float(self.forward[1])))))
 
     def down_2d(self) -> FloatArray:
         """The head's down direction in the unturned image (unit, 2-D)."""

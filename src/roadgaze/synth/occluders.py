@@ -2,10 +2,10 @@
 
 **A hand at 12 o'clock** (`hand_at_12`): the driver grips the top of the steering wheel. The hand
 and forearm stay where the wheel is while the head turns, so they are placed in the camera's
-image, relative to where the face rests (the unturned mesh), by camera mounting. How much of the
-face they hide depends on where the camera sits (roadgaze's own estimates for the presets of
-`roadgaze.pose.mounting`, in face widths W below the eye line; the fist is drawn at 1.2 times
-its size next to the face, being nearer the camera):
+image, relative to where the eyes are when the driver looks at the road, by camera mounting.
+How much of the face they hide depends on where the camera sits (roadgaze's own estimates for
+the presets of `roadgaze.pose.mounting`, in face widths W below the eye line; the fist is drawn
+at 1.2 times its size next to the face, being nearer the camera):
 
 - `steering_column`: the hand hangs from the rim into the wheel's opening right in front of the
   lens: the fist over the nose (0.25 W below the eyes), the forearm on to the elbow, below and
@@ -73,12 +73,18 @@ def _skin(renderer: FaceRenderer) -> FloatArray:
 
 
 def hand_at_12(
-    frame: ImageBGR, renderer: FaceRenderer, mounting: str, cabin: str = "lhd"
+    frame: ImageBGR,
+    renderer: FaceRenderer,
+    mounting: str,
+    cabin: str = "lhd",
+    rest_deg: tuple[float, float] = (0.0, 0.0),
 ) -> ImageBGR:
     """`frame` with a hand gripping the top of the wheel as a camera at `mounting` sees it (in
-    `cabin`): the forearm (rounded: darker at its edges) from the fist to the image's edge, the
-    rim either side of the fist, the fist over both (lit from above, the creases between the
-    fingers), all a little out of focus (`BLUR_W`: nearer the lens than the face it focuses on)."""
+    `cabin`), placed from where the eyes are with the head at `rest_deg` (the yaw and pitch of
+    the road pose as that camera sees it, rendered): the forearm (rounded: darker at its edges)
+    from the fist to the image's edge, the rim either side of the fist, the fist over both (lit
+    from above, the creases between the fingers), all a little out of focus (`BLUR_W`: nearer
+    the lens than the face it focuses on)."""
     import cv2
 
     placement = PLACEMENTS.get(mounting)
@@ -86,7 +92,7 @@ def hand_at_12(
         return frame
     width = renderer.mesh.face_width_px
     mirror = -1.0 if cabin == "rhd" else 1.0
-    eyes = renderer.mesh.points_px[[33, 263], :2].mean(axis=0)
+    eyes = renderer.turned_points(*rest_deg)[[33, 263], :2].mean(axis=0)
     centre = eyes + np.array([mirror * placement.across_w, placement.below_eyes_w]) * width
     forearm = np.array([mirror * placement.forearm[0], placement.forearm[1]])
     forearm /= np.linalg.norm(forearm)

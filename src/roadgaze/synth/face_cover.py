@@ -105,13 +105,14 @@ class MaskBelowChin:
     ) -> ImageBGR:
         import cv2
 
-        top, bottom = under_jaw(renderer, self.drop_w, -0.3, yaw_deg, pitch_deg, mouth_open)
+        top, bottom, along = under_jaw(renderer, self.drop_w, -0.3, yaw_deg, pitch_deg, mouth_open)
         opened = renderer.jaw.open(renderer.mesh.points_px, mouth_open)
         head = HeadFrame.of(renderer)
         out = frame.copy()
-        polygon = np.round(np.vstack([top, bottom[::-1]]) * 16).astype(np.int32)
-        shade = tuple(round(0.78 * c) for c in MASK_BGR)
-        cv2.fillPoly(out, [polygon], shade, cv2.LINE_AA, 4)
+        if len(along) >= 2:
+            polygon = np.round(np.vstack([top, bottom[::-1]]) * 16).astype(np.int32)
+            shade = tuple(round(0.78 * c) for c in MASK_BGR)
+            cv2.fillPoly(out, [polygon], shade, cv2.LINE_AA, 4)
         for upper, lower, side in ((234, 132, -1.0), (454, 361, 1.0)):
             if math.sin(math.radians(yaw_deg)) * side > -0.15:
                 continue  # the camera does not see this side of the head

@@ -113,18 +113,23 @@ def under_jaw(
     yaw_deg: float,
     pitch_deg: float,
     mouth_open: float,
-) -> tuple[FloatArray, FloatArray]:
-    """(N, 2) pixels of the turned (and opened) jaw line and of the line `drop_w` (per jaw
-    point, in face widths) below it along the head, moved forward by `ahead` times the drop:
-    the top and the bottom of what hangs under the jaw."""
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """What hangs under the jaw, as the frame shows it: (N, 2) pixels of the turned (and
+    opened) jaw line, of the line `drop_w` (per jaw point, in face widths) below it along the
+    head, moved forward by `ahead` times the drop, and each jaw point's place along the line
+    (0..1). Only the jaw points on the camera's side of the neck pivot are kept: the far side
+    of the jaw hides behind the face when the head turns."""
     head = HeadFrame.of(renderer)
     jaw = renderer.jaw.open(renderer.mesh.points_px, mouth_open)[list(JAW_LINE)]
     offsets = np.column_stack([np.zeros_like(drop_w), -drop_w, ahead * drop_w])
     hanging = np.vstack(
         [head.at(point, row[None, :]) for point, row in zip(jaw, offsets, strict=True)]
     )
-    top = turn(renderer, jaw, yaw_deg, pitch_deg)[:, :2]
-    return top, turn(renderer, hanging, yaw_deg, pitch_deg)[:, :2]
+    top = turn(renderer, jaw, yaw_deg, pitch_deg)
+    seen = top[:, 2] < renderer.mesh.pivot_px[2]
+    along = np.linspace(0.0, 1.0, len(JAW_LINE))
+    bottom = turn(renderer, hanging, yaw_deg, pitch_deg)[:, :2]
+    return top[seen, :2], bottom[seen], along[seen]
 
 
 class BeardBelowChin:
@@ -149,20 +154,22 @@ class BeardBelowChin:
     ) -> ImageBGR:
         import cv2
 
-        top, bottom = under_jaw(renderer, self.drop_w, 0.2, yaw_deg, pitch_deg, mouth_open)
+        top, bottom, along = under_jaw(renderer, self.drop_w, 0.2, yaw_deg, pitch_deg, mouth_open)
+        if len(along) < 2:
+            return frame
         out = frame.copy()
         polygon = np.round(np.vstack([top, bottom[::-1]]) * 16).astype(np.int32)
         cv2.fillPoly(out, [polygon], HAIR_BGR, cv2.LINE_AA, 4)
-        along = np.linspace(0.0, 1.0, len(JAW_LINE))
 
         def place(u: FloatArray, v: FloatArray) -> FloatArray:
             upper = np.column_stack([np.interp(u, along, top[:, i]) for i in (0, 1)])
             lower = np.column_stack([np.interp(u, along, bottom[:, i]) for i in (0, 1)])
             return np.asarray(upper + v[:, None] * (lower - upper), dtype=np.float64)
 
-        u, v = self.strokes[:, 0], self.strokes[:, 1] * 0.85
-        starts, ends = place(u, v), place(u, np.minimum(1.0, v + self.lengths))
-        for start, end, shade in zip(starts, ends, self.shades, strict=True):
+        shown = (self.strokes[:, 0] >= along[0]) & (self.strokes[:, 0] <= along[-1])
+        u, v = self.strokes[shown, 0], self.strokes[shown, 1] * 0.85
+        starts, ends = place(u, v), place(u, np.minimum(1.0, v + self.lengths[shown]))
+        for start, end, shade in zip(starts, ends, self.shades[shown], strict=True):
             bgr = tuple(min(255.0, c * shade) for c in HAIR_BGR)
             line = np.round(np.vstack([start, end]) * 16).astype(np.int32)
             cv2.polylines(out, [line], False, bgr, 1, cv2.LINE_AA, 4)

@@ -32,8 +32,9 @@ from roadgaze.synth.clip import write_truth_csv
 from roadgaze.synth.effects import NoiseBank, covered_frame, night
 from roadgaze.synth.eyes import EyeRenderer, EyeState
 from roadgaze.synth.head import HeadFrame
+from roadgaze.synth.layers import Layer
 from roadgaze.synth.mouth import speech_track
-from roadgaze.synth.occluders import hand_at_12
+from roadgaze.synth.occluders import hand_layer
 from roadgaze.synth.outfit import WORN, Outfit, check_conditions
 from roadgaze.synth.renderer import ImageBGR
 from roadgaze.synth.timeline import Keyframe, Timeline
@@ -85,6 +86,7 @@ class ScenarioRenderer:
         self.facing_pitch_deg = HeadFrame.of(renderer).facing_pitch_deg
         """Added to every rendered pitch: the photo's face looks this far below its camera."""
         self._outfits: dict[tuple[str, ...], Outfit] = {}
+        self._hands: dict[str, Layer | None] = {}
 
     def outfit(self, conditions: tuple[str, ...]) -> Outfit:
         """The face dressed in the worn ones of `conditions` (built once per combination)."""
@@ -92,6 +94,14 @@ class ScenarioRenderer:
         if worn not in self._outfits:
             self._outfits[worn] = Outfit(self.renderer, worn)
         return self._outfits[worn]
+
+    def _hand(self, preset: str) -> Layer | None:
+        """The hand on the wheel as the camera at `preset` sees it (built once per camera)."""
+        if preset not in self._hands:
+            road_yaw, road_pitch, _ = head_to_camera(mounting_for(preset, self.cabin), 0.0, 0.0)
+            rest = (road_yaw, road_pitch + self.facing_pitch_deg)
+            self._hands[preset] = hand_layer(self.renderer, preset, self.cabin, rest)
+        return self._hands[preset]
 
     def _face(
         self,
@@ -108,10 +118,8 @@ class ScenarioRenderer:
             outfit = self.outfit(scenario.conditions)
             state = EyeState.both(float(row[3]), float(row[4]), float(row[5]))
             frame = outfit.render(yaw, pitch, state, mouth_open)
-            if "hand_at_12" in scenario.conditions:
-                road_yaw, road_pitch, _ = head_to_camera(mounting, 0.0, 0.0)
-                rest = (road_yaw, road_pitch + self.facing_pitch_deg)
-                frame = hand_at_12(frame, outfit.renderer, scenario.mounting, self.cabin, rest)
+            hand = self._hand(scenario.mounting) if "hand_at_12" in scenario.conditions else None
+            frame = frame if hand is None else hand.over(frame)
             cache[key] = frame
         return cache[key]
 

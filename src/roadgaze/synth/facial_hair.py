@@ -42,6 +42,8 @@ HAIR_BGR = (34, 38, 48)
 STUBBLE_ALPHA, STUBBLE_GRAIN = 0.3, 0.25
 BEARD_ALPHA = 0.92
 BEARD_DROP_W = 0.28
+SHADE_STEPS = (0.8, 1.05, 1.3)
+"""The hanging beard's strokes are drawn in four tones (darker and lighter than `HAIR_BGR`)."""
 STROKE_W = (0.03, 0.08)
 """A beard stroke's length, in face widths."""
 
@@ -169,8 +171,10 @@ class BeardBelowChin:
         shown = (self.strokes[:, 0] >= along[0]) & (self.strokes[:, 0] <= along[-1])
         u, v = self.strokes[shown, 0], self.strokes[shown, 1] * 0.85
         starts, ends = place(u, v), place(u, np.minimum(1.0, v + self.lengths[shown]))
-        for start, end, shade in zip(starts, ends, self.shades[shown], strict=True):
+        lines = np.round(np.stack([starts, ends], axis=1) * 16).astype(np.int32)
+        tones = np.digitize(self.shades[shown], SHADE_STEPS)  # one drawing call per tone
+        for tone in np.unique(tones):
+            shade = float(np.r_[0.55, SHADE_STEPS][tone] + 0.25)
             bgr = tuple(min(255.0, c * shade) for c in HAIR_BGR)
-            line = np.round(np.vstack([start, end]) * 16).astype(np.int32)
-            cv2.polylines(out, [line], False, bgr, 1, cv2.LINE_AA, 4)
+            cv2.polylines(out, list(lines[tones == tone]), False, bgr, 1, cv2.LINE_AA, 4)
         return out

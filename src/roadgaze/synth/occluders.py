@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.synth.layers import Layer
 from roadgaze.synth.renderer import FaceRenderer, ImageBGR
 from roadgaze.types import FloatArray
 
@@ -79,17 +80,30 @@ def hand_at_12(
     cabin: str = "lhd",
     rest_deg: tuple[float, float] = (0.0, 0.0),
 ) -> ImageBGR:
-    """`frame` with a hand gripping the top of the wheel as a camera at `mounting` sees it (in
-    `cabin`), placed from where the eyes are with the head at `rest_deg` (the yaw and pitch of
-    the road pose as that camera sees it, rendered): the forearm (rounded: darker at its edges)
-    from the fist to the image's edge, the rim either side of the fist, the fist over both (lit
-    from above, the creases between the fingers), all a little out of focus (`BLUR_W`: nearer
-    the lens than the face it focuses on)."""
+    """`frame` with a hand gripping the top of the wheel as a camera at `mounting` sees it
+    (`hand_layer`; the frame as it is where the camera does not see the hand)."""
+    layer = hand_layer(renderer, mounting, cabin, rest_deg)
+    return frame if layer is None else layer.over(frame)
+
+
+def hand_layer(
+    renderer: FaceRenderer,
+    mounting: str,
+    cabin: str = "lhd",
+    rest_deg: tuple[float, float] = (0.0, 0.0),
+) -> Layer | None:
+    """The hand gripping the top of the wheel as a camera at `mounting` sees it (in `cabin`),
+    over the renderer's whole frame, placed from where the eyes are with the head at `rest_deg`
+    (the yaw and pitch of the road pose as that camera sees it, rendered): the forearm (rounded:
+    darker at its edges) from the fist to the image's edge, the rim either side of the fist,
+    the fist over both (lit from above, the creases between the fingers), all a little out of
+    focus (`BLUR_W`: nearer the lens than the face it focuses on). None where the camera does
+    not see it. Build it once per camera and composite it on every frame."""
     import cv2
 
     placement = PLACEMENTS.get(mounting)
     if placement is None:
-        return frame
+        return None
     width = renderer.mesh.face_width_px
     mirror = -1.0 if cabin == "rhd" else 1.0
     eyes = renderer.turned_points(*rest_deg)[[33, 263], :2].mean(axis=0)
@@ -97,7 +111,7 @@ def hand_at_12(
     forearm = np.array([mirror * placement.forearm[0], placement.forearm[1]])
     forearm /= np.linalg.norm(forearm)
     skin = _skin(renderer).astype(np.float32)
-    height, columns = frame.shape[:2]
+    columns, height = renderer.size
     colour = np.zeros((height, columns, 3), dtype=np.float32)
     alpha = np.zeros((height, columns), dtype=np.float32)
     ys, xs = np.mgrid[0:height, 0:columns].astype(np.float32)
@@ -150,5 +164,4 @@ def hand_at_12(
     spread = np.asarray(cv2.GaussianBlur(colour * alpha[..., None], (0, 0), blur))
     soft = np.asarray(cv2.GaussianBlur(alpha, (0, 0), blur))[..., None]
     shown = np.where(soft > 1e-3, spread / np.maximum(soft, 1e-3), 0.0)
-    mixed = frame.astype(np.float32) * (1.0 - soft) + shown * soft
-    return np.asarray(np.clip(mixed + 0.5, 0, 255), dtype=np.uint8)
+    return Layer(shown.astype(np.float32), soft[..., 0].astype(np.float32))

@@ -263,11 +263,13 @@ def headwear(
     crown = np.zeros(out.shape[:2], dtype=np.uint8)
     cv2.fillConvexPoly(crown, cv2.convexHull(shown(_crown(wear.crown_w))), 255, cv2.LINE_AA, 4)
     rows = np.flatnonzero(crown.any(axis=1))
-    if rows.size:
-        light = np.interp(np.arange(out.shape[0]), [rows[0], rows[-1]], [1.1, 0.75])
+    if rows.size:  # lit from above: 1.1 of its colour at the top to 0.75 at the band
+        top, bottom = int(rows[0]), int(rows[-1]) + 1
+        light = np.linspace(1.1, 0.75, bottom - top)
         lit = np.asarray(wear.bgr, np.float32)[None, None, :] * light[:, None, None]
-        alpha = (crown.astype(np.float32) / 255.0)[..., None]
-        out = np.clip(out * (1.0 - alpha) + lit * alpha + 0.5, 0, 255).astype(np.uint8)
+        alpha = (crown[top:bottom].astype(np.float32) / 255.0)[..., None]
+        band = out[top:bottom].astype(np.float32)
+        out[top:bottom] = np.clip(band * (1.0 - alpha) + lit * alpha + 0.5, 0, 255)
     front = brim(-min(wear.brim_deg, 90.0), min(wear.brim_deg, 90.0))
     cv2.fillPoly(out, [front], brim_bgr, cv2.LINE_AA, 4)
     cv2.polylines(out, [front], True, edge_bgr, 1, cv2.LINE_AA, 4)

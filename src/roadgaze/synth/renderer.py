@@ -214,10 +214,12 @@ class FaceRenderer:
         self.triangles = mesh_triangles()
         self._front_sign = self._majority_sign(points)
         self.mouth_inside = inside_triangles(self.triangles)
-        # The hole fillers have no set winding: take it from the photo, the mouth's from an
-        # opened jaw (a closed mouth's strip is too thin to tell).
+        # The hole fillers have no set winding: take it from the photo, and for a mouth closed
+        # too tightly to tell (a sliver under 0.5 px^2) from the jaw opened half way.
         areas = self._signed_areas(points)
-        areas[self.mouth_inside] = self._signed_areas(self.jaw.open(points, 0.5))[self.mouth_inside]
+        opened = self._signed_areas(self.jaw.open(points, 0.5))
+        slivers = np.intersect1d(self.mouth_inside, np.flatnonzero(np.abs(areas) < 0.5))
+        areas[slivers] = opened[slivers]
         backwards = areas * self._front_sign < 0
         backwards[:TESSELLATION_TRIANGLES] = False
         self.triangles[backwards] = self.triangles[backwards][:, ::-1]

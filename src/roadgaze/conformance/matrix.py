@@ -75,11 +75,13 @@ def _glance(
     duration_s: float = LOOK_S,
     fast: bool = False,
     mounting: str = "front",
-    sunglasses: bool = False,
+    conditions: tuple[str, ...] = (),
 ) -> Scenario:
-    """A look at `target` for `duration_s` at `speed_kmh` that must warn in its window."""
+    """A look at `target` for `duration_s` at `speed_kmh` that must warn in its window (under
+    dark sunglasses, within ADDW's non-nominal allowance)."""
+    hidden_eyes = "dark_sunglasses" in conditions
     requirement = expect.distraction(
-        config, speed_kmh, f"{name}.warns", what, non_nominal=sunglasses
+        config, speed_kmh, f"{name}.warns", what, non_nominal=hidden_eyes
     )
     segments = (ahead(), look(target, duration_s), back())
     return Scenario(
@@ -89,7 +91,7 @@ def _glance(
         speed_kmh,
         (requirement,),
         mounting=mounting,
-        sunglasses=sunglasses,
+        conditions=conditions,
         fast=fast,
     )
 
@@ -162,7 +164,7 @@ def distraction_scenarios(config: MonitorConfig) -> list[Scenario]:
             f"4 s lap glance in sunglasses at {fast_kmh_text}",
             lap,
             FAST_KMH,
-            sunglasses=True,
+            conditions=("dark_sunglasses",),
         ),
     ]
     slow = "8 s lap glance at 10 km/h"

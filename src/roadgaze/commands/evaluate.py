@@ -70,7 +70,8 @@ def register(subparsers: Any) -> None:
         metavar="NAME",
         help="run the condition suite instead: the images with |yaw| <= 60, clean and under "
         "this cabin condition (repeatable, or `all`: ir_grey, dark, glare, motion_blur, jpeg, "
-        "low_res, sunglasses, mask; docs/conditions.md), one table row each",
+        "low_res, sunglasses, mask; docs/conditions.md), one table row each; NAME:KEY=VALUE,... "
+        "sets a condition's parameters, e.g. ir_grey:noise_std=9",
     )
     parser.set_defaults(handler=run)
 

@@ -172,3 +172,21 @@ def test_a_condition_takes_other_values_for_its_parameters(scene: np.ndarray) ->
 def test_bad_condition_parameters_are_named(text: str, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         condition_names([text])
+
+
+def test_the_suite_counts_faces_per_subject() -> None:
+    from roadgaze.evaluation.condition_suite import format_subject_table, score_condition
+    from roadgaze.evaluation.ground_truth import GroundTruth
+    from roadgaze.evaluation.images import ImageEstimate
+
+    truths = [GroundTruth(f"{i}.jpg", 0.0, 0.0, subject) for i, subject in enumerate("aabbb")]
+    found = [True, False, True, True, False]
+    estimates = [ImageEstimate(file=t.file, face=f) for t, f in zip(truths, found, strict=True)]
+    row = score_condition("dark", truths, estimates)
+    assert row.faces_by_subject == (("a", 1, 2), ("b", 2, 3))
+    assert row.to_json_dict()["subjects"][1] == {"subject": "b", "faces": 2, "images": 3}
+    assert format_subject_table([row]) == (
+        "| faces found % by subject | a | b |\n|---|---|---|\n| dark | 50.0 | 66.7 |"
+    )
+    anonymous = [GroundTruth(t.file, 0.0) for t in truths]
+    assert format_subject_table([score_condition("dark", anonymous, estimates)]) is None

@@ -191,6 +191,7 @@ def run_conditions(
     from roadgaze.evaluation.condition_suite import (
         estimate_conditions,
         format_condition_table,
+        format_subject_table,
         score_conditions,
         suite_truths,
     )
@@ -213,6 +214,9 @@ def run_conditions(
         f"landmarks.enhance = {config.landmarks.enhance}"
     )
     print(format_condition_table(table))
+    by_subject = format_subject_table(table)
+    if by_subject is not None:
+        print(f"\n{by_subject}")
     if args.report is not None:
         document = {
             "dataset": str(args.dataset),

@@ -7,10 +7,12 @@ Writes VIDEO looped to SECONDS into a temporary file (the camera-like stand-in: 
 file at its own frame rate), then starts, as a user would, three processes on 127.0.0.1:
 `roadgaze router`, `roadgaze listen --json` (the subscriber) and `roadgaze run` in client mode.
 At --restart-at (default: half way) the router is stopped with SIGTERM and started again on the
-same port after --outage seconds (default 10). Every 10 s the daemon's resident memory (VmRSS)
-and CPU time are sampled (--csv keeps the samples). At the end it prints the daemon's frames and
-alerts, the alerts the subscriber received and missed, both exit codes, the memory baseline
-(after 60 s), end, peak and growth, and the CPU share of one core.
+same port after --outage seconds (default 10). --nice N runs the daemon at that niceness (a
+vehicle computer gives the monitor priority; on a shared machine -10 keeps it paced). Every
+10 s the daemon's resident memory (VmRSS) and CPU time are sampled (--csv keeps the samples).
+At the end it prints the daemon's frames and alerts, the alerts the subscriber received and
+missed, both exit codes, the memory baseline (after 60 s), end, peak and growth, and the CPU
+share of one core.
 """
 
 from __future__ import annotations
@@ -89,6 +91,9 @@ def main() -> int:
     parser.add_argument("--restart-at", type=float, default=None)
     parser.add_argument("--outage", type=float, default=10.0)
     parser.add_argument("--csv", type=Path, default=None)
+    parser.add_argument(
+        "--nice", type=int, default=0, help="the daemon's niceness (negative: before other jobs)"
+    )
     parser.add_argument("--keep", type=Path, default=None, help="keep the logs in this folder")
     args = parser.parse_args()
     restart_at = args.seconds / 2 if args.restart_at is None else args.restart_at
@@ -110,6 +115,7 @@ def main() -> int:
     )
     daemon = subprocess.Popen(
         [ROADGAZE, "run", "--source", str(drive), *client],
+        preexec_fn=(lambda: os.nice(args.nice)) if args.nice else None,
         stdout=subprocess.DEVNULL,
         stderr=(work / "run.err").open("wb"),
     )

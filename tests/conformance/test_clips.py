@@ -16,8 +16,8 @@ from roadgaze.conformance.clips import RenderedSource, ScenarioRenderer
 from roadgaze.conformance.model import Scenario, Segment
 from roadgaze.errors import ConfigError
 from roadgaze.pose.mounting import FRONT, head_to_camera, mounting_for
-from roadgaze.synth.lean import leaned
 from roadgaze.synth.eyes import EyeState
+from roadgaze.synth.lean import leaned
 
 FPS = 5.0
 

@@ -35,6 +35,7 @@ renderer.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from roadgaze.mounting import Cabin, CameraMounting, rotation
@@ -130,20 +131,33 @@ LOCATIONS: tuple[Location, ...] = (
 LOCATION_NAMES = tuple(loc.name for loc in LOCATIONS)
 
 
-def locations_for(cabin: Cabin) -> tuple[Location, ...]:
-    """The locations in this cabin: right-hand drive mirrors y (the names are by side)."""
-    if cabin == "lhd":
-        return LOCATIONS
-    if cabin != "rhd":
+def locations_for(
+    cabin: Cabin, points_m: Mapping[str, Vector3] | None = None
+) -> tuple[Location, ...]:
+    """The locations in this cabin: right-hand drive mirrors y (the names are by side); a
+    location in `points_m` (the cabin's own, not mirrored) lies there instead."""
+    if cabin not in ("lhd", "rhd"):
         raise ValueError(f"unknown cabin {cabin!r} (cabins: lhd, rhd)")
+    own = points_m or {}
+    unknown = sorted(set(own) - set(LOCATION_NAMES))
+    if unknown:
+        raise ValueError(
+            f"unknown gaze locations {unknown} (locations: {', '.join(LOCATION_NAMES)})"
+        )
+    sign = 1.0 if cabin == "lhd" else -1.0
     return tuple(
-        replace(loc, point_m=(loc.point_m[0], -loc.point_m[1], loc.point_m[2])) for loc in LOCATIONS
+        replace(loc, point_m=own[loc.name], source="the cabin's own (configured)")
+        if loc.name in own
+        else replace(loc, point_m=(loc.point_m[0], sign * loc.point_m[1], loc.point_m[2]))
+        for loc in LOCATIONS
     )
 
 
-def location(name: str, cabin: Cabin = "lhd") -> Location:
+def location(
+    name: str, cabin: Cabin = "lhd", points_m: Mapping[str, Vector3] | None = None
+) -> Location:
     """The location `name` in this cabin; ValueError naming the known ones."""
-    for loc in locations_for(cabin):
+    for loc in locations_for(cabin, points_m):
         if loc.name == name:
             return loc
     raise ValueError(f"unknown gaze location {name!r} (locations: {', '.join(LOCATION_NAMES)})")

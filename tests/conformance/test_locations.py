@@ -3,9 +3,21 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from pathlib import Path
+
 import pytest
 
-from roadgaze.cabin import FACE_WIDTH_M, FacePlace, camera_distance_m, face_seen, location
+from repo_paths import child_env
+from roadgaze.cabin import (
+    FACE_WIDTH_M,
+    FacePlace,
+    camera_distance_m,
+    direction_deg,
+    face_seen,
+    location,
+)
 from roadgaze.config import MonitorConfig
 from roadgaze.conformance.locations import EYE_REACH_DEG, LEANS_M, location_scenarios, look_at
 from roadgaze.conformance.matrix import PITCH_LIMITS_DEG, scenario_matrix
@@ -69,3 +81,37 @@ def test_the_leaning_picture_moves_the_face_where_the_camera_sees_it(preset: str
     still = lean_affine(size, width_px, FRONT, (0.0, 0.0, 0.0))
     assert still[0] == pytest.approx((1.0, 0.0, 0.0))
     assert still[1] == pytest.approx((0.0, 1.0, 0.0))
+
+
+@pytest.mark.parametrize(
+    ("toml", "says"),
+    [
+        (
+            '[monitor]\nlocations = [{ name = "sunroof", point_m = [0.5, 0.0, 0.4] }]\n',
+            "unknown gaze location 'sunroof'",
+        ),
+        ('[monitor]\nprotocol = "ncap"\n', "monitor.protocol"),
+    ],
+    ids=["location", "protocol"],
+)
+def test_an_unknown_location_or_protocol_is_one_line_and_exit_2(
+    tmp_path: Path, toml: str, says: str
+) -> None:
+    config = tmp_path / "roadgaze.toml"
+    config.write_text(toml, encoding="utf-8")
+    done = subprocess.run(
+        [sys.executable, "-m", "roadgaze", "conformance", "--config", str(config), "--only",
+         "lean_road_70", "--out", str(tmp_path / "out")],
+        capture_output=True, text=True, env=child_env(), timeout=120, check=False,
+    )  # fmt: skip
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0] and "Traceback" not in done.stderr
+
+
+def test_a_cabin_s_own_location_is_where_the_scenarios_look() -> None:
+    own = MonitorConfig(locations=[{"name": "glovebox", "point_m": (0.6, -0.9, -0.6)}])  # type: ignore[list-item]
+    look = look_at(own, "glovebox", "owl", 4.0)
+    assert (look.yaw_deg, look.pitch_deg) == pytest.approx(direction_deg((0.6, -0.9, -0.6)))
+    with pytest.raises(ValueError, match="at most once"):
+        MonitorConfig(locations=[{"name": "glovebox", "point_m": (0.6, -0.9, -0.6)}] * 2)  # type: ignore[list-item]

@@ -65,7 +65,8 @@ def look_at(
         lean = (lean[0], lean[1] if cabin == "lhd" else -lean[1], lean[2])
         if name == "road":
             return Segment(duration_s, label=label, lean_m=lean)
-    yaw, pitch = location(name, cabin).direction_deg(lean)
+    points = {own.name: own.point_m for own in config.locations}
+    yaw, pitch = location(name, cabin, points).direction_deg(lean)
     if movement == "lizard":
         eye_yaw = _clamp(yaw, -EYE_REACH_DEG, EYE_REACH_DEG)
         eye_pitch = _clamp(pitch, -EYE_REACH_DEG, EYE_REACH_DEG)

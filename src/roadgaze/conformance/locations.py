@@ -78,15 +78,20 @@ def look_at(
     return Segment(duration_s, head_yaw, head_pitch, label=label, lean_m=lean)
 
 
-def _long(config: MonitorConfig, name: str, movement: str) -> Scenario:
+def _long(config: MonitorConfig, name: str, movement: str, mounting: str = "front") -> Scenario:
     scenario = f"{movement}_{name}_70"
     what = f"4 s {movement} look at the {name.replace('_', ' ')} at 70 km/h"
     if movement == "lean":
         what = f"4 s body lean toward the {name.replace('_', ' ')} at 70 km/h"
+    if mounting != "front":
+        scenario = f"preset_{mounting}_{scenario}"
+        what = f"{what}, camera on the {mounting.replace('_', ' ')}"
     requirement = expect.distraction(config, FAST_KMH, f"{scenario}.warns", what)
     segments = (ahead(), look_at(config, name, movement, LOOK_S), back())
     zoom = LEAN_ZOOM if movement == "lean" else 1.0
-    return Scenario(scenario, what, segments, FAST_KMH, (requirement,), zoom=zoom)
+    return Scenario(
+        scenario, what, segments, FAST_KMH, (requirement,), mounting=mounting, zoom=zoom
+    )
 
 
 def _short(
@@ -136,6 +141,7 @@ def location_scenarios(config: MonitorConfig) -> list[Scenario]:
         _long(config, "passenger_footwell", "lean"),
         _long(config, "rear_passenger", "lean"),
         _long(config, "road", "lean"),
+        _long(config, "road", "lean", "steering_column"),
         _short(config, "vats_owl_passenger_footwell_70", "owl", ("passenger_footwell",)),
         _short(config, "vats_lizard_infotainment_70", "lizard", ("infotainment",)),
         _short(config, "vats_lizard_passenger_footwell_70", "lizard", ("passenger_footwell",)),

@@ -11,7 +11,7 @@ from fakes import open_eyes
 from roadgaze.cabin import FACE_WIDTH_M, FacePlace, face_seen
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor import AlertKind, Monitor
-from roadgaze.monitor.lean import HeadPlace, face_place, leaning, step_place
+from roadgaze.monitor.lean import SETTLE_S, HeadPlace, face_place, leaning, step_place
 from roadgaze.mounting import FRONT, mounting_for
 from roadgaze.types import FaceFeatures, PoseSample
 
@@ -70,7 +70,8 @@ def test_the_driving_place_is_learned_on_the_road_and_a_lean_read_against_it() -
     after = step_place(config, FRONT, place, sample_at(1.0, leaned), (0.0, 0.0), True)
     assert after.lean_m == pytest.approx((0.0, -0.25, -0.1))
     assert leaning(config, after.lean_m)
-    assert after.reference == place.reference  # a lean teaches nothing
+    assert after.reference == place.reference  # a lean teaches nothing once settled
+    assert place.learned_s >= SETTLE_S
     assert not leaning(config, (0.0, -0.1, -0.1))
     assert not leaning(MonitorConfig(lean_limit_m=10.0), after.lean_m)
 
@@ -107,3 +108,16 @@ def test_a_turned_head_from_a_mounted_camera_is_no_lean() -> None:
     place = HeadPlace(REFERENCE, 10.0, 0.0)
     after = step_place(MonitorConfig(), mounting, place, sample_at(0.1, seen), (60.0, 0.0), False)
     assert after.lean_m == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
+
+
+def test_a_first_face_seen_leaning_is_learned_away_while_settling() -> None:
+    # The first face is seen 0.3 m to the side (the driver getting in); within the first second
+    # of road time the driving place follows the driver, so the driving posture is no lean.
+    config = MonitorConfig()
+    aside = face_seen(FRONT, 0.7, REFERENCE, (0.0, -0.3, 0.0))
+    place = step_place(config, FRONT, HeadPlace(), sample_at(0.0, aside), (0.0, 0.0), True)
+    for frame in range(1, round(3.0 * FPS)):
+        place = step_place(
+            config, FRONT, place, sample_at(frame / FPS, REFERENCE), (0.0, 0.0), True
+        )
+    assert place.lean_m is not None and not leaning(config, place.lean_m)

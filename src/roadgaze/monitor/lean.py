@@ -3,7 +3,8 @@ and judged against its driving place. Pure.
 
 The face's image place at the driving place (`FacePlace`: the face box's centre and size) is
 learned from samples judged on the road, as the neutral pose is: a running mean for its first
-`neutral_time_constant_s`, then a first-order filter of that time constant. Against it, each face
+`neutral_time_constant_s`, then a first-order filter of that time constant; after its first
+`SETTLE_S` of road time a leaning head teaches it nothing. Against it, each face
 gives the head's displacement (`roadgaze.cabin.head_place_m`, with the camera mounting and its
 distance, the turn of the head about the neck removed). A head moved more than `lean_limit_m`
 toward either side or down is leaning out of the driving place: a driver reaching to the
@@ -23,13 +24,16 @@ from roadgaze.monitor.zones import LEAN
 from roadgaze.mounting import CameraMounting
 from roadgaze.types import PoseSample
 
-__all__ = ["LEAN_ZONE", "HeadPlace", "face_place", "leaning", "step_place"]
+__all__ = ["LEAN_ZONE", "SETTLE_S", "HeadPlace", "face_place", "leaning", "step_place"]
 
 LEAN_ZONE = LEAN
 _MAX_STEP_S = 1.0
 """A longer gap between samples teaches the driving place no more than one second would."""
 _FIRST_S = 0.1
 """The first face taught counts as this much road time in the running mean."""
+SETTLE_S = 1.0
+"""For its first second of road time the driving place learns even from a head that reads as
+leaning (the first face may have been seen while the driver settled in), as the neutral does."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -82,7 +86,8 @@ def step_place(
     if reference is not None:
         distance = camera_distance_m(mounting, config.camera_distance_m)
         lean = head_place_m(mounting, distance, reference, seen, *turn_deg)
-    if not on_road or leaning(config, lean):
+    settling = previous.learned_s < SETTLE_S
+    if not on_road or (leaning(config, lean) and not settling):
         return HeadPlace(reference, previous.learned_s, previous.t_s, lean)
     if reference is None or previous.t_s is None:
         return HeadPlace(seen, _FIRST_S, sample.t_s, lean)

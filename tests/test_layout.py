@@ -40,6 +40,8 @@ PURE_MODULES = (
     "roadgaze.eye_records",
     "roadgaze.hand_records",
     "roadgaze.mounting",
+    "roadgaze.cabin",
+    "roadgaze.monitor.lean",
     "roadgaze.evaluation.stats",
     "roadgaze.synth.timeline",
 )
@@ -58,6 +60,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
         "csv_rows",
         "config",
         "mounting",
+        "cabin",
         "hand_records",
         "threads",
     ),

@@ -117,7 +117,9 @@ def test_zones_come_from_the_configuration_road_first() -> None:
     assert (road.yaw_min_deg, road.yaw_max_deg) == (-25.0, 25.0)  # left at 30, entered at 25
     assert (road.pitch_min_deg, road.pitch_max_deg) == (-10.0, 15.0)
     assert zones.driving_related == frozenset({"rear_mirror"})
-    assert zones.names == ("road", "rear_mirror", "far_left", "far_right", "roof", "away")
+    assert zones.names == (
+        "road", "rear_mirror", "far_left", "far_right", "roof", "body_lean", "away"
+    )  # fmt: skip
 
 
 def test_bad_set_syntax_is_reported() -> None:

@@ -15,8 +15,9 @@ from roadgaze.capture.speed_track import read_speed_track
 from roadgaze.conformance.clips import RenderedSource, ScenarioRenderer
 from roadgaze.conformance.model import Scenario, Segment
 from roadgaze.errors import ConfigError
-from roadgaze.pose.mounting import head_to_camera, mounting_for
+from roadgaze.pose.mounting import FRONT, head_to_camera, mounting_for
 from roadgaze.synth.eyes import EyeState
+from roadgaze.synth.lean import leaned
 
 FPS = 5.0
 
@@ -61,6 +62,21 @@ def test_a_preset_renders_the_face_as_its_camera_sees_it(renderer: ScenarioRende
     seen = renderer.renderer.render_eyes(yaw, pitch + facing, EyeState()).astype(np.float64)
     front = renderer.renderer.render_eyes(0.0, -35.0 + facing, EyeState()).astype(np.float64)
     assert np.abs(frame - seen).mean() < 3.0 < np.abs(frame - front).mean()
+
+
+def test_a_lean_moves_the_face_as_the_camera_sees_the_head_moved(
+    renderer: ScenarioRenderer,
+) -> None:
+    lean = (0.1, -0.2, -0.15)
+    segments = (Segment(1.0), Segment(1.0, lean_m=lean))
+    frames = list(renderer.frames(Scenario("lean", "", segments, 70.0, (), zoom=0.7)))
+    facing = renderer.facing_pitch_deg
+    still = renderer.renderer.render_eyes(0.0, facing, EyeState())
+    width_px = renderer.renderer.mesh.face_width_px
+    at_rest = leaned(still, width_px, FRONT, (0.0, 0.0, 0.0), 0.7).astype(np.float64)
+    moved = leaned(still, width_px, FRONT, lean, 0.7).astype(np.float64)
+    assert np.abs(frames[0] - at_rest).mean() < 3.0 < np.abs(frames[0] - moved).mean()
+    assert np.abs(frames[-1] - moved).mean() < 3.0 < np.abs(frames[-1] - at_rest).mean()
 
 
 def test_the_road_pose_faces_the_camera(renderer: ScenarioRenderer) -> None:

@@ -14,7 +14,7 @@ def test_the_configured_defaults_are_the_documented_table() -> None:
     assert DEFAULTS.zones == DEFAULT_ZONES
     assert DEFAULTS.names == (
         "road", "lap", "cluster", "centre_stack", "left_mirror", "right_mirror",
-        "far_left", "far_right", "roof", "away",
+        "far_left", "far_right", "roof", "body_lean", "away",
     )  # fmt: skip
     assert DEFAULTS.driving_related == frozenset({"left_mirror", "right_mirror"})
 

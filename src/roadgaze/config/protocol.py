@@ -56,6 +56,9 @@ class ProtocolSettings(Section):
     """Explicit camera yaw (driver's frame, > 0 = to the driver's left) instead of the preset's."""
     camera_pitch_deg: float | None = Field(default=None, ge=-89, le=89)
     camera_roll_deg: float | None = Field(default=None, ge=-180, le=180)
+    camera_distance_m: float | None = Field(default=None, gt=0, le=3)
+    """The camera's distance from the driver's head at its driving place (metres), for the
+    head's place (body lean, roadgaze.cabin); None: the preset's estimate."""
 
     distraction_yaw_deg: float = Field(default=55.0, gt=0, le=55)
     """ADDW area 1: beyond +-this yaw from the driver's forward direction is always distraction

@@ -19,6 +19,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
 from roadgaze.config.hands import HandsConfig
+from roadgaze.config.locations import LocationConfig
 from roadgaze.config.protocol import ProtocolSettings
 from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section as _Section
@@ -202,6 +203,13 @@ class MonitorConfig(EyeMonitorSettings, ProtocolSettings):
     """A face lost while |yaw - neutral| exceeded this counts as turned away, not unavailable;
     None: a face lost while the head was off road (outside the road zone) is turned away."""
     min_speed_kmh: float = Field(default=20.0, ge=0)
+    locations: list[LocationConfig] = Field(default_factory=list, max_length=32)
+    """Gaze locations of this cabin where they differ from roadgaze's estimates
+    (roadgaze.cabin; each name at most once): where the conformance scenarios look."""
+    lean_limit_m: float = Field(default=0.15, gt=0)
+    """Body lean: a head moved farther than this sideways or down from its driving place (its
+    face's learned image place, roadgaze.cabin) is off road (zone `body_lean`), whatever it
+    faces (a large value: never)."""
 
     @field_validator("road_pitch_deg")
     @classmethod
@@ -218,9 +226,14 @@ class MonitorConfig(EyeMonitorSettings, ProtocolSettings):
                 f"road_half_width_deg ({self.road_half_width_deg})"
             )
         names = [zone.name for zone in self.zones]
-        reserved = sorted({"road", "away"} & set(names))
+        reserved = sorted({"road", "away", "body_lean"} & set(names))
         if reserved or len(set(names)) != len(names):
-            raise ValueError(f"zone names must be unique and not 'road' or 'away', found {names}")
+            raise ValueError(
+                f"zone names must be unique and not 'road', 'away' or 'body_lean', found {names}"
+            )
+        located = [location.name for location in self.locations]
+        if len(set(located)) != len(located):
+            raise ValueError(f"each gaze location at most once in locations, found {located}")
         unknown = sorted(set(self.driving_related_zones) - set(names))
         if unknown:
             raise ValueError(

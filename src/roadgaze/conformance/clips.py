@@ -33,11 +33,12 @@ from roadgaze.synth.effects import NoiseBank, covered_frame, night
 from roadgaze.synth.eyes import EyeRenderer, EyeState
 from roadgaze.synth.head import HeadFrame
 from roadgaze.synth.layers import Layer
+from roadgaze.synth.lean import leaned
 from roadgaze.synth.mouth import speech_track
 from roadgaze.synth.occluders import hand_layer
 from roadgaze.synth.outfit import WORN, Outfit, check_conditions
 from roadgaze.synth.renderer import ImageBGR
-from roadgaze.synth.timeline import Keyframe, Timeline
+from roadgaze.synth.timeline import DEFAULT_TRANSITION_S, Keyframe, Timeline, eased
 from roadgaze.types import FloatArray, Frame
 
 MOUTH_STEP = 0.02
@@ -57,6 +58,18 @@ def timeline_of(scenario: Scenario) -> Timeline:
             )
             for s in scenario.segments
         )
+    )
+
+
+def leans_m(scenario: Scenario, t_s: FloatArray) -> FloatArray:
+    """(N, 3) the head's displacement from its driving place at each time (driver's frame,
+    metres), eased as the turn is."""
+    durations = [segment.duration_s for segment in scenario.segments]
+    return np.column_stack(
+        [
+            eased([s.lean_m[axis] for s in scenario.segments], durations, DEFAULT_TRANSITION_S, t_s)
+            for axis in range(3)
+        ]
     )
 
 
@@ -109,16 +122,20 @@ class ScenarioRenderer:
         row: FloatArray,
         mouth_open: float,
         cache: dict[tuple[float, ...], ImageBGR],
+        lean_m: FloatArray,
     ) -> ImageBGR:
         mounting = mounting_for(scenario.mounting, self.cabin)
         yaw, camera_pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
         pitch = camera_pitch + self.facing_pitch_deg
-        key = tuple(round(float(v), 4) for v in (yaw, pitch, *row[3:6], mouth_open))
+        lean = (float(lean_m[0]), float(lean_m[1]), float(lean_m[2]))
+        key = tuple(round(float(v), 4) for v in (yaw, pitch, *row[3:6], mouth_open, *lean))
         if key not in cache:
             outfit = self.outfit(scenario.conditions)
             state = EyeState.both(float(row[3]), float(row[4]), float(row[5]))
             frame = outfit.render(yaw, pitch, state, mouth_open)
             hand = self._hand(scenario.mounting) if "hand_at_12" in scenario.conditions else None
+            width_px = self.renderer.mesh.face_width_px
+            frame = leaned(frame, width_px, mounting, lean, scenario.zoom)
             frame = frame if hand is None else hand.over(frame)
             cache[key] = frame
         return cache[key]
@@ -129,6 +146,7 @@ class ScenarioRenderer:
         check_conditions(scenario.conditions)
         truth = timeline_of(scenario).eye_truth(self.fps)
         states = camera_states(scenario, truth[:, 0])
+        leans = leans_m(scenario, truth[:, 0])
         seed = zlib.crc32(scenario.name.encode())
         rng = np.random.default_rng(seed)
         noise = NoiseBank(self.renderer.size, rng)
@@ -138,7 +156,7 @@ class ScenarioRenderer:
             mouth = np.round(speech_track(truth[:, 0], seed) / MOUTH_STEP) * MOUTH_STEP
         cache: dict[tuple[float, ...], ImageBGR] = {}
         last: ImageBGR | None = None
-        for row, state, opening in zip(truth, states, mouth, strict=True):
+        for row, state, opening, lean in zip(truth, states, mouth, leans, strict=True):
             if state == "frozen" and last is not None:
                 frame = last
             elif state == "covered":
@@ -147,7 +165,7 @@ class ScenarioRenderer:
                 seen = (
                     self.renderer.background
                     if state == "no_face"
-                    else self._face(scenario, row, float(opening), cache)
+                    else self._face(scenario, row, float(opening), cache, lean)
                 )
                 frame = night(seen, rng) if at_night else noise(seen)
             last = frame

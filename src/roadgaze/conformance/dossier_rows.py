@@ -88,16 +88,21 @@ def _row(
 
 
 ND, DT = "Non-driving task", "Driving task"
+_LIZARD_INFOTAINMENT = ("lizard_infotainment_70.warns",)
+_LEAN_FOOTWELL = ("lean_passenger_footwell_70.warns", "lean_road_70.warns")
+"""A lean toward the footwell warns, and so does a lean that keeps the face to the road (the
+head's place is measured, not only where it faces)."""
 _LONG_ROWS = (
     _row(17, LONG, ND, "Owl", "Driver side window", LD, ("side_{driver}_70.warns",)),
     _row(18, LONG, ND, "Owl", "In-vehicle infotainment system", LD, ("centre_stack_70.warns",)),
-    _row(19, LONG, ND, "Owl", "Passenger footwell", LD),
-    _row(20, LONG, ND, "Owl", "Passenger face", LD),
+    # Gaze locations (roadgaze.cabin, scenarios: roadgaze.conformance.locations).
+    _row(19, LONG, ND, "Owl", "Passenger footwell", LD, ("owl_passenger_footwell_70.warns",)),
+    _row(20, LONG, ND, "Owl", "Passenger face", LD, ("owl_passenger_face_70.warns",)),
     _row(21, LONG, ND, "Owl", "Passenger side window", LD, ("side_{passenger}_70.warns",)),
-    _row(22, LONG, ND, "Lizard", "In-vehicle infotainment system", LD),
-    _row(23, LONG, ND, "Lizard", "Glovebox", LD),
-    _row(24, LONG, ND, "Body lean", "Passenger footwell", LD),
-    _row(25, LONG, ND, "Body lean", "Rear passenger", LD),
+    _row(22, LONG, ND, "Lizard", "In-vehicle infotainment system", LD, _LIZARD_INFOTAINMENT),
+    _row(23, LONG, ND, "Lizard", "Glovebox", LD, ("lizard_glovebox_70.warns",)),
+    _row(24, LONG, ND, "Body lean", "Passenger footwell", LD, _LEAN_FOOTWELL),
+    _row(25, LONG, ND, "Body lean", "Rear passenger", LD, ("lean_rear_passenger_70.warns",)),
     _row(26, LONG, DT, "Owl", "Driver side mirror", (), NA),
     _row(27, LONG, DT, "Owl", "Rear view mirror", (), NA),
     _row(28, LONG, DT, "Owl", "Passenger side mirror", (), NA),
@@ -106,11 +111,27 @@ _LONG_ROWS = (
     _row(31, LONG, DT, "Lizard", "Rear view mirror", (), NA),
 )
 _VATS_INFOTAINMENT = ("vats_70.warns", "vats_70.no_long", "vats_below_70.quiet")
+
+
+def _vats(glances: str) -> tuple[str, ...]:
+    """A short-distraction row's evidence: its glances add up to VATS, none warns on its own."""
+    return (f"vats_{glances}_70.warns", f"vats_{glances}_70.no_long")
+
+
 _SHORT_ROWS = (
     _row(35, SHORT, ND, "Owl", "In-vehicle infotainment system", VATS, _VATS_INFOTAINMENT),
-    _row(36, SHORT, ND, "Owl", "Passenger footwell", VATS),
-    _row(37, SHORT, ND, "Lizard", "In-vehicle infotainment system", VATS),
-    _row(38, SHORT, ND, "Lizard", "Passenger footwell", VATS),
+    # Gaze locations (roadgaze.cabin, scenarios: roadgaze.conformance.locations).
+    _row(36, SHORT, ND, "Owl", "Passenger footwell", VATS, _vats("owl_passenger_footwell")),
+    _row(
+        37,
+        SHORT,
+        ND,
+        "Lizard",
+        "In-vehicle infotainment system",
+        VATS,
+        _vats("lizard_infotainment"),
+    ),
+    _row(38, SHORT, ND, "Lizard", "Passenger footwell", VATS, _vats("lizard_passenger_footwell")),
     _row(39, SHORT, DT, "Owl", "Driver side mirror", (), NA),
     _row(40, SHORT, DT, "Owl", "Rear view mirror", (), NA),
     _row(41, SHORT, DT, "Owl", "Passenger side mirror", (), NA),
@@ -119,7 +140,7 @@ _SHORT_ROWS = (
     _row(44, SHORT, DT, "Lizard", "Driver side mirror", (), NA),
     _row(45, SHORT, DT, "Lizard", "Instrument cluster", (), NA),
     _row(46, SHORT, DT, "Lizard", "Rear view mirror", (), NA),
-    _row(47, SHORT, "Multi-target", "Lizard", "", VATS),
+    _row(47, SHORT, "Multi-target", "Lizard", "", VATS, _vats("lizard_multi_target")),
 )
 BASIC, ADVANCED = "Basic phone use", "Advanced phone use"
 _PHONE_ROWS = (

@@ -33,6 +33,9 @@ class Segment:
     openness: float = 1.0
     camera: CameraState = "face"
     label: str = ""
+    lean_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """The head moved from its driving place (driver's frame: forward, left, up; metres), over
+    the same transition as the turn: a body lean."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,6 +73,9 @@ class Scenario:
     `roadgaze.synth.outfit.CONDITIONS` (`dark_sunglasses`, `night`, `mask`, `talking`, ...)."""
     fast: bool = False
     """Part of the `--fast` subset (the test suite's)."""
+    zoom: float = 1.0
+    """The camera's picture scaled about its centre (< 1: a wider lens, the face smaller, so a
+    leaning head stays in view)."""
 
     @property
     def sunglasses(self) -> bool:

@@ -5,10 +5,11 @@ Pure; measured once per sample before the behaviours run (`roadgaze.monitor.cont
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.eye_rules import eye_zone_map
+from roadgaze.monitor.lean import LEAN_ZONE, HeadPlace, leaning, step_place
 from roadgaze.monitor.neutral import NeutralPose
 from roadgaze.monitor.zones import AWAY, ROAD, ZoneMap
 from roadgaze.mounting import CameraMounting, gaze_to_driver
@@ -66,6 +67,8 @@ class Look:
     """The zone was judged on the eyes' gaze, not the head pose."""
     last_face_yaw_deg: float | None = None
     """The yaw of the last sample with a usable yaw."""
+    place: HeadPlace = field(default_factory=HeadPlace)
+    """The head's place (body lean) and its learned driving place (roadgaze.monitor.lean)."""
 
     @property
     def on_road(self) -> bool:
@@ -77,6 +80,8 @@ class Look:
         """Why the driver counts as off road, for the alert's `reason`."""
         if self.turned_away:
             return f"face out of view, last seen in {self.zone}"
+        if self.zone == LEAN_ZONE:
+            return "head leaning out of the driving place"
         if self.gaze is Gaze.UNKNOWN:
             return "face out of view"
         return f"{'eyes' if self.by_eyes else 'head'} in {self.zone}"
@@ -99,13 +104,23 @@ def classify(
     neutral: NeutralPose,
     sample: PoseSample,
     eyes: EyesVerdict,
+    mounting: CameraMounting | None = None,
 ) -> Look:
-    """Where the driver looks at `sample` (in the driver's frame), after `previous`."""
+    """Where the driver looks at `sample` (in the driver's frame), after `previous`; a head
+    leaning out of the driving place is off road (`roadgaze.monitor.lean`)."""
     gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes = _judge(
         config, zones, previous, neutral, sample, eyes
     )
     last_yaw = yaw if yaw is not None else previous.last_face_yaw_deg
-    return Look(gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes, last_yaw)
+    turn = (
+        0.0 if yaw is None else yaw - neutral.yaw_deg,
+        0.0 if pitch is None else pitch - neutral.pitch_deg,
+    )
+    mounting = CameraMounting.from_config(config) if mounting is None else mounting
+    place = step_place(config, mounting, previous.place, sample, turn, zone == ROAD)
+    if leaning(config, place.lean_m) and (zone == ROAD or zones.is_driving_related(zone)):
+        gaze, zone, face_zone, by_eyes = Gaze.OFF_ROAD, LEAN_ZONE, LEAN_ZONE, False
+    return Look(gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes, last_yaw, place)
 
 
 def _judge(

@@ -48,7 +48,7 @@ def observe(
         head_yaw,
         state.neutral.pitch_deg if head_pitch is None else head_pitch,
     )
-    look = classify(config, zones, state.look, state.neutral, sample, eyes.verdict)
+    look = classify(config, zones, state.look, state.neutral, sample, eyes.verdict, mounting)
     issue = frame_issue(config, sample.frame_check)
     # ADDW's allowance applies when the service knows conditions are non-nominal: eyes hidden,
     # or a poor frame.

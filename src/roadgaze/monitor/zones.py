@@ -36,6 +36,7 @@ __all__ = [
     "AWAY",
     "DEFAULT_DRIVING_RELATED",
     "DEFAULT_ZONES",
+    "LEAN",
     "ROAD",
     "Zone",
     "ZoneMap",
@@ -44,6 +45,8 @@ __all__ = [
 
 ROAD = "road"
 AWAY = "away"
+LEAN = "body_lean"
+"""A head leaning out of the driving place (roadgaze.monitor.lean): off road, not a rectangle."""
 FAR_LEFT, FAR_RIGHT, ROOF = AREA1_ZONE_NAMES
 AREA1_ZONES = AREA1_ZONE_NAMES
 """ADDW's distraction area 1: beyond the +-55 deg planes (the driver's left, right) and the roof."""
@@ -155,8 +158,10 @@ class ZoneMap:
             raise ValueError(f"zone names {list(AREA1_ZONES)} are reserved, found {names}")
         if not names or names[0] != ROAD:
             raise ValueError(f"the first zone must be '{ROAD}', found {names[:1]}")
-        if AWAY in names or len(set(names)) != len(names):
-            raise ValueError(f"zone names must be unique and not '{AWAY}', found {names}")
+        if AWAY in names or LEAN in names or len(set(names)) != len(names):
+            raise ValueError(
+                f"zone names must be unique and not '{AWAY}' or '{LEAN}', found {names}"
+            )
         unknown = sorted(self.driving_related - set(names))
         if ROAD in self.driving_related or unknown:
             raise ValueError(
@@ -167,7 +172,7 @@ class ZoneMap:
     @property
     def names(self) -> tuple[str, ...]:
         """Every zone a sample can be given: the configured ones, then area 1's, then `away`."""
-        return (*(zone.name for zone in self.zones), *AREA1_ZONES, AWAY)
+        return (*(zone.name for zone in self.zones), *AREA1_ZONES, LEAN, AWAY)
 
     def classify(self, yaw_deg: float, pitch_deg: float, previous_zone: str | None) -> str:
         """ADDW's area 1 first, else `classify_zone` with this map's zones and hysteresis."""

@@ -62,6 +62,13 @@ def _eased(
     return values
 
 
+def eased(
+    targets: list[float], durations: list[float], ramp_s: float, t_s: npt.ArrayLike
+) -> FloatArray:
+    """Holds of `targets` for `durations` with the timeline's cosine-eased ramps between."""
+    return _eased(targets, durations, ramp_s, np.asarray(t_s, dtype=np.float64))
+
+
 @dataclass(frozen=True, slots=True)
 class Timeline:
     """Keyframes with cosine-eased transitions: `transition_s` for the head, `eye_transition_s`

@@ -126,8 +126,9 @@ class YawMessage(EyeFields):
     zone: str | None = Field(
         default=None,
         description="Glance zone: road, lap, cluster, centre_stack, left_mirror, right_mirror "
-        "(or another configured zone), far_left / far_right / roof (ADDW's distraction area 1) "
-        "or away; null when the gaze is unknown.",
+        "(or another configured zone), far_left / far_right / roof (ADDW's distraction area 1), "
+        "body_lean (the head moved out of the driving place) or away; null when the gaze is "
+        "unknown.",
     )
     eyes_on_road: bool | None = Field(
         default=None,

@@ -1,13 +1,16 @@
 """The drowsiness level: its arithmetic on scripted eye, mouth and pitch tracks (each expectation
 in closed form), the mouth's opening from the lips' landmarks, and the `drowsy` behaviour's speed
-gate (50 km/h under Euro NCAP; an unknown speed warns and says so)."""
+gate (50 km/h under Euro NCAP; an unknown speed warns and says so), and a nod through the whole
+monitor."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from fakes import eyes_of
 from roadgaze.config import MonitorConfig
+from roadgaze.monitor import Monitor
 from roadgaze.monitor.behaviours import Drowsy, DrowsyState
 from roadgaze.monitor.context import Context
 from roadgaze.monitor.drowsiness import (
@@ -184,3 +187,27 @@ def test_under_euroncap_drowsiness_warns_from_50_kmh_and_at_unknown_speed() -> N
     # Under ADDW alone, whenever moving (ADDW's lowest speed decides).
     assert len(step(30.0, protocol="addw")) == 1
     assert euroncap.DROWSINESS.until_trip_end and not euroncap.DROWSINESS_SPEED.until_trip_end
+
+
+def nod_drive(speed_kmh: float | None) -> list[tuple[str, float, str]]:
+    """The whole monitor: 3 s ahead, the lids close, 0.2 s later the head drops 20 deg for
+    0.6 s, back up and open at 3.8 s (a 0.8 s closure: a long blink, no microsleep)."""
+    config = MonitorConfig(protocol="euroncap", neutral_yaw_deg=0.0, neutral_pitch_deg=0.0)
+    monitor, alerts = Monitor(config), []
+    for frame in range(round(6.0 * 15)):
+        t_s = frame / 15
+        closed = 3.0 <= t_s + 1e-9 < 3.8
+        pitch = -20.0 if 3.2 <= t_s + 1e-9 < 3.8 else 0.0
+        sample = PoseSample(
+            t_s, frame, True, 0.0, 0.0, 0.0, 1.0, n_faces=1, pitch_raw_deg=pitch,
+            pitch_deg=pitch, eyes=eyes_of(openness=0.08) if closed else eyes_of(),
+        )  # fmt: skip
+        alerts += [(a.label, a.t_s, a.reason) for a in monitor.update(sample, speed_kmh)]
+    return alerts
+
+
+def test_a_nod_alone_reaches_level_7_through_the_whole_monitor_at_70_not_at_40() -> None:
+    ((label, t_s, reason),) = nod_drive(70.0)
+    assert label == "drowsy:warning" and reason == "drowsiness level 7: 1 nod"
+    assert t_s == pytest.approx(3.8, abs=1 / 15 + 1e-6)  # when the head is back up
+    assert nod_drive(40.0) == []

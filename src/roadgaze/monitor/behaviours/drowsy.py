@@ -13,7 +13,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from roadgaze.monitor.context import Context
-from roadgaze.monitor.drowsiness import DrowsinessSigns, Level, level_of, mouth_opening, track_signs
+from roadgaze.monitor.drowsiness import (
+    BASE_LEVEL,
+    DrowsinessSigns,
+    Level,
+    level_of,
+    mouth_opening,
+    track_signs,
+)
 from roadgaze.monitor.events import Event, Raise, Resolve, Rule
 from roadgaze.types import AlertKind, AlertLevel, EyeStatus
 
@@ -26,7 +33,7 @@ class DrowsyState:
     """It may fire."""
     signs: DrowsinessSigns = field(default_factory=DrowsinessSigns)
     """The mouth's and the head's signs (yawns, nods) within the window."""
-    level: Level = field(default_factory=lambda: Level(5, ()))
+    level: Level = field(default_factory=lambda: Level(BASE_LEVEL, ()))
     """The level after the last sample."""
 
 

@@ -82,16 +82,19 @@ def test_the_filled_sheet_holds_the_dossiers_values(tmp_path: Path) -> None:
     out = write_dossier(template(), dossier, tmp_path / "d.xlsx")
     ws = openpyxl.load_workbook(out)[SHEET]
     assert [ws[c].value for c in ("D17", "E17", "F17", "D69")] == ["Green", "Red", "Red", "Red"]
-    assert [ws[c].value for c in ("D70", "D71", "F72", "D26", "F68")] == [
+    assert [ws[c].value for c in ("D70", "D71", "F72", "D26", "F68", "D68", "D69")] == [
         "Green",
         "Red",
         "Green",
         None,
         None,
+        "Green",  # drowsiness
+        "Red",  # non-fatigue impairment: nothing detects it
     ]
     assert ws["D2"].value == "Non Functional" and ws["D4"].value == "Non Functional"
     assert ws["D3"].value == "Functional"  # clear sunglasses: every GREEN cell passed under them
     greens = sum(c.value == "Green" for row in ws["D17:F72"] for c in row)
-    # Warnings of rows 17-25, 35-38, 47 and 70, 72's emergency function (sleep_70 failed).
-    assert greens == sum(c.colour == "Green" for c in dossier.cells) == 16
+    # Warnings of rows 17-25, 35-38, 47, 68 (drowsiness) and 70, 72's emergency function
+    # (sleep_70 failed).
+    assert greens == sum(c.colour == "Green" for c in dossier.cells) == 17
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d.xlsx"]

@@ -17,6 +17,7 @@ from typing import Any, Literal, Self
 
 from pydantic import Field, ValidationError, field_validator, model_validator
 
+from roadgaze.config.drowsiness import DrowsinessSettings
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
 from roadgaze.config.hands import HandsConfig
 from roadgaze.config.locations import LocationConfig
@@ -161,7 +162,7 @@ class SmoothingConfig(_Section):
         return self
 
 
-class MonitorConfig(EyeMonitorSettings, ProtocolSettings):
+class MonitorConfig(EyeMonitorSettings, DrowsinessSettings, ProtocolSettings):
     """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)

@@ -3,13 +3,13 @@
 The head pose and eyes of the scenario (driver's frame) go through the camera mounting
 (`roadgaze.mounting.head_to_camera`) and are rendered as that camera sees the face (a head
 pose of 0, 0 in the camera's frame faces the lens: the photo's own downward look,
-`HeadFrame.facing_pitch_deg`, is nodded away), dressed
-in what the scenario's `conditions` name (`roadgaze.synth.outfit`: glasses, a mask, a beard, a
-cap, ...), the jaw moving with speech when it is `talking`, a hand on the wheel where the camera
-sees it (`hand_at_12`); sensor noise goes on every frame (a held pose is not a frozen camera),
-or at `night` the infrared picture with its own noise (`roadgaze.synth.effects.night`). A covered
-lens is a dark flat frame, no face the cabin without the driver, frozen frames the last frame
-again, byte for byte. `RenderedSource` hands the frames to the loop
+`HeadFrame.facing_pitch_deg`, is nodded away), dressed in what the scenario's `conditions` name
+(`roadgaze.synth.outfit`: glasses, a mask, a beard, a cap, ...), the jaw moving with speech when
+it is `talking` and opening as its segments yawn (`mouth_track`), a hand on the wheel where the
+camera sees it (`hand_at_12`); sensor noise goes on every frame (a held pose is not a frozen
+camera), or at `night` the infrared picture with its own noise (`roadgaze.synth.effects.night`).
+A covered lens is a dark flat frame, no face the cabin without the driver, frozen frames the
+last frame again, byte for byte. `RenderedSource` hands the frames to the loop
 as a video file would, rendered in the loop's decode thread (so rendering overlaps MediaPipe);
 with a clip path it also writes them losslessly (FFV1), so `roadgaze replay NAME.mkv` shows the
 same drive. The speed track (`roadgaze.capture.speed_track`) holds the scenario's speed every
@@ -78,6 +78,27 @@ def camera_states(scenario: Scenario, t_s: FloatArray) -> list[CameraState]:
     ends = np.cumsum([segment.duration_s for segment in scenario.segments])
     index = np.minimum(np.searchsorted(ends, t_s, side="right"), len(ends) - 1)
     return [scenario.segments[int(i)].camera for i in index]
+
+
+MOUTH_RAMP_S = 0.8
+"""A segment's mouth opens and closes over this (a yawn gapes slowly and closes fast; eased)."""
+
+
+def mouth_track(scenario: Scenario, t_s: FloatArray) -> FloatArray:
+    """The jaw's opening the segments hold at each time (0 where none opens), eased over
+    `MOUTH_RAMP_S` at each segment's ends."""
+    opening = np.zeros(len(t_s))
+    start = 0.0
+    for segment in scenario.segments:
+        end = start + segment.duration_s
+        if segment.mouth_open > 0.0:
+            inside = (t_s >= start) & (t_s < end)
+            ramp = min(MOUTH_RAMP_S, segment.duration_s / 2.0)
+            edge = np.minimum(t_s[inside] - start, end - t_s[inside]) / ramp
+            ease = 0.5 - 0.5 * np.cos(np.pi * np.clip(edge, 0.0, 1.0))
+            opening[inside] = segment.mouth_open * ease
+        start = end
+    return opening
 
 
 def write_speed_track(path: Path, speed_kmh: float, duration_s: float) -> None:
@@ -151,9 +172,10 @@ class ScenarioRenderer:
         rng = np.random.default_rng(seed)
         noise = NoiseBank(self.renderer.size, rng)
         at_night = "night" in scenario.conditions
-        mouth = np.zeros(len(truth))
+        mouth = mouth_track(scenario, truth[:, 0])
         if "talking" in scenario.conditions:
-            mouth = np.round(speech_track(truth[:, 0], seed) / MOUTH_STEP) * MOUTH_STEP
+            mouth = np.maximum(mouth, speech_track(truth[:, 0], seed))
+        mouth = np.round(mouth / MOUTH_STEP) * MOUTH_STEP
         cache: dict[tuple[float, ...], ImageBGR] = {}
         last: ImageBGR | None = None
         for row, state, opening, lean in zip(truth, states, mouth, leans, strict=True):

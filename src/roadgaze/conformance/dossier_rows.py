@@ -159,10 +159,13 @@ _PHONE_ROWS = (
     _row(63, PHONE, ADVANCED, "Lizard", "Phone held in view of windscreen", ()),
     _row(64, PHONE, ADVANCED, "Lizard", "Phone held in view of instrument cluster", ()),
 )
+# Drowsiness (impairment by fatigue): roadgaze.conformance.drowsiness.
+DROWSINESS = (euroncap.DROWSINESS, euroncap.DROWSINESS_SPEED)
+_DROWSINESS = ("drowsy_70.warns", "alert_70.quiet", "drowsy_40.quiet")
 _MICROSLEEP = ("microsleep_70.warns", "microsleep_70.no_sleep")
 _UNRESPONSIVE = ("unresponsive_closed_70.warns", "unresponsive_away_70.warns")
 _NON_TRANSIENT_ROWS = (
-    _row(68, NON_TRANSIENT, "Impairment", "", "Drowsiness", (), (), (), NA),
+    _row(68, NON_TRANSIENT, "Impairment", "", "Drowsiness", DROWSINESS, _DROWSINESS, (), NA),
     _row(69, NON_TRANSIENT, "Impairment", "", "Non-fatigue", (), (), (), NA),
     _row(70, NON_TRANSIENT, "Microsleep", "", "", (euroncap.MICROSLEEP,), _MICROSLEEP, (), NA),
     _row(71, NON_TRANSIENT, "Sleep", "", "", (euroncap.SLEEP,), ("sleep_70.warns",), (), NA),
@@ -276,7 +279,9 @@ GENERAL_REQUIREMENTS: tuple[GeneralRequirement, ...] = (
         "Speed activation condition for the impairment driver states, when the vehicle is moving "
         "forward at a speed of at least 50 km/h",
         "speed activation of impairment (>= 50 km/h)",
-        missing="no impairment (drowsiness) rule yet",
+        _DROWSINESS,
+        basis="drowsiness warns at 70 km/h and not at 40 km/h (drowsiness_min_speed_kmh 50); "
+        "non-fatigue impairment is not detected (its row stays RED)",
     ),
     GeneralRequirement(
         "Assisted Driving prerequisite (≥50% of Driving collaboration and ≥50% of Driver "

@@ -232,6 +232,7 @@ def preset_scenarios(config: MonitorConfig) -> list[Scenario]:
 
 def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
     """Every scenario, in report order."""
+    from roadgaze.conformance.drowsiness import drowsiness_scenarios
     from roadgaze.conformance.locations import location_scenarios
     from roadgaze.conformance.timers import camera_scenarios, eye_scenarios, vats_scenarios
 
@@ -242,4 +243,6 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
         *camera_scenarios(config),
         *preset_scenarios(config),
         *location_scenarios(config),
+        # Drowsiness (impairment): roadgaze.conformance.drowsiness.
+        *drowsiness_scenarios(config),
     ]

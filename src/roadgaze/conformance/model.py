@@ -23,7 +23,8 @@ lens, or the last frame again (frozen)."""
 class Segment:
     """A stretch of the drive: the head turns to `yaw_deg`/`pitch_deg` (driver's frame, degrees;
     over the timeline's transition at the start) and holds; the eyes turn (eye-in-head degrees)
-    and open to `openness`; `label` marks the segment so a requirement can start its clock."""
+    and open to `openness`; the mouth opens to `mouth_open` (a yawn); `label` marks the segment
+    so a requirement can start its clock."""
 
     duration_s: float
     yaw_deg: float = 0.0
@@ -36,6 +37,9 @@ class Segment:
     lean_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     """The head moved from its driving place (driver's frame: forward, left, up; metres), over
     the same transition as the turn: a body lean."""
+    mouth_open: float = 0.0
+    """The jaw's opening held in the segment (a fraction of a wide yawn,
+    `roadgaze.synth.mouth`), eased in and out over `MOUTH_RAMP_S` at its ends."""
 
 
 @dataclass(frozen=True, slots=True)

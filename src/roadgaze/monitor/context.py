@@ -55,6 +55,8 @@ class Context:
     """Alerts raised before this sample and not yet cleared, in the order they were raised."""
     events: tuple[Event, ...] = ()
     """What the behaviours before this one handed back at this sample."""
+    neutral_pitch_deg: float = 0.0
+    """The road-ahead pitch the sample is judged against (driver's frame; fixed or learned)."""
 
     @property
     def t_s(self) -> float:

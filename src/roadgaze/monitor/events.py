@@ -27,6 +27,9 @@ class Rule:
     unit: str
     source: str
     what: str
+    until_trip_end: bool = False
+    """What this rule raises is not transient (Euro NCAP: drowsiness): a support it asks for
+    is held to the end of the trip, not cleared by looking at the road."""
 
     @property
     def protocol(self) -> str:

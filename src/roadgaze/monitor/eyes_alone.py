@@ -31,7 +31,7 @@ from roadgaze.types import AlertKind, EyesVerdict, Gaze, PoseSample
 __all__ = ["EyesAlone", "clearable_eye_kinds", "step_eyes"]
 
 _CLOSURE = EyeClosure(euroncap.MICROSLEEP, euroncap.SLEEP, euroncap.UNRESPONSIVE_CLOSED)
-_DROWSY = Drowsy(roadgaze.DROWSY)
+_DROWSY = Drowsy(roadgaze.DROWSY, euroncap.DROWSINESS, euroncap.DROWSINESS_SPEED)
 _DEGRADED = Degraded(euroncap.IMPAIRED)
 _EYE_KINDS = (*CLOSURE_ALERTS, AlertKind.DROWSY, AlertKind.DEGRADED)
 

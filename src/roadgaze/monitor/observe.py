@@ -77,6 +77,7 @@ def observe(
         frame_issue=issue,
         trigger=distraction_trigger(config, speed_kmh, non_nominal) if moving else None,
         active=state.active,
+        neutral_pitch_deg=state.neutral.pitch_deg,
     )
     neutral = learn_neutral(
         config,

@@ -53,7 +53,7 @@ TABLE: tuple[tuple[str, Behaviour[Any]], ...] = (
     ("euroncap", Vats(euroncap.VATS, rearm=euroncap.VATS_REARM)),
     ("roadgaze", Unavailable(roadgaze.UNAVAILABLE)),
     ("roadgaze", EyeClosure(euroncap.MICROSLEEP, euroncap.SLEEP, euroncap.UNRESPONSIVE_CLOSED)),
-    ("roadgaze", Drowsy(roadgaze.DROWSY)),
+    ("roadgaze", Drowsy(roadgaze.DROWSY, euroncap.DROWSINESS, euroncap.DROWSINESS_SPEED)),
     ("roadgaze", Degraded(euroncap.IMPAIRED)),
     ("euroncap", Unresponsive(euroncap.UNRESPONSIVE_AWAY, euroncap.UNRESPONSIVE_AFTER_WARNING)),
     (

@@ -14,6 +14,8 @@ from roadgaze.monitor.events import Rule, Trigger
 
 __all__ = [
     "ACTIVE",
+    "DROWSINESS",
+    "DROWSINESS_SPEED",
     "IMPAIRED",
     "LONG_DISTRACTION",
     "MICROSLEEP",
@@ -97,9 +99,28 @@ IMPAIRED = Rule(
     f"{_DSM}: impaired monitoring told to the driver within 10 s",
     "eyes unavailable this long: monitoring degraded",
 )
+# Drowsiness (impairment by fatigue): the level and its speed.
+_SD_2026 = "Euro NCAP 2026 Safe Driving, Driver Engagement"
+DROWSINESS = Rule(
+    "euroncap.drowsiness",
+    "drowsiness_warn_level",
+    "level",
+    f"{_SD_2026}: drowsiness at a level equivalent to KSS 7 or more (smarteye.se's summary of "
+    "the 2026 protocol); the level is roadgaze's KSS-like scale of sourced signs",
+    "warn at this drowsiness level or above",
+    until_trip_end=True,
+)
+DROWSINESS_SPEED = Rule(
+    "euroncap.drowsiness.min_speed",
+    "drowsiness_min_speed_kmh",
+    "km/h",
+    f"{_SD_2026}: impairment driver states active when moving forward at at least 50 km/h "
+    "(the rating calculator's general requirement)",
+    "drowsiness warns only at this speed or above",
+)
 _DISTRACTION = (ACTIVE, LONG_DISTRACTION, VATS, VATS_WINDOW, VATS_REARM)
 _UNRESPONSIVE = (UNRESPONSIVE_AFTER_WARNING, UNRESPONSIVE_AWAY, UNRESPONSIVE_CLOSED)
-RULES = (*_DISTRACTION, *_UNRESPONSIVE, MICROSLEEP, SLEEP, IMPAIRED)
+RULES = (*_DISTRACTION, *_UNRESPONSIVE, MICROSLEEP, SLEEP, IMPAIRED, DROWSINESS, DROWSINESS_SPEED)
 
 
 def active(config: MonitorConfig, speed_kmh: float | None) -> bool:

@@ -217,13 +217,17 @@ def test_strong_smoothing_flattens_the_noise_and_keeps_an_edge() -> None:
     np.testing.assert_array_equal(enhance(FLAT, strong=True), clean)
 
 
-def test_a_noisy_hard_still_is_looked_at_curved_then_strong_with_retries() -> None:
+def test_a_noisy_hard_still_is_looked_at_ever_more_smoothly_with_retries() -> None:
     inner = SteppedDetector(lambda image: False)
     assert FrontEndDetector(inner).detect(NOISY_FLAT).driver is None  # type: ignore[arg-type]
     images = [image for _, image, _ in inner.seen]
-    assert len(images) == 2 and [retry for _, _, retry in inner.seen] == [True, True]
+    assert len(images) == 4 and [retry for _, _, retry in inner.seen] == [True] * 4
     np.testing.assert_array_equal(images[0], enhance(NOISY_FLAT))
     np.testing.assert_array_equal(images[1], enhance(NOISY_FLAT, strong=True))
+    np.testing.assert_array_equal(images[2], enhance(NOISY_FLAT, version="coarse"))
+    np.testing.assert_array_equal(images[3], enhance(NOISY_FLAT, version="wide"))
+    assert grain(images[2]) < grain(images[1]) < grain(images[0])  # coarse: less grain again
+    assert grain(images[3]) < grain(images[0])
     clean = SteppedDetector(lambda image: False)  # no noise: as it came instead of strong
     FrontEndDetector(clean).detect(FLAT)  # type: ignore[arg-type]
     assert [(image.ndim, retry) for _, image, retry in clean.seen] == [(2, True), (3, False)]
@@ -246,9 +250,9 @@ def test_a_stream_holds_the_strong_version_and_waits_without_a_face() -> None:
     front_end = FrontEndDetector(never)  # type: ignore[arg-type]
     for index in range(12):
         front_end.detect(NOISY_FLAT, index * 0.1)
-    # Two looks with retries at 0 s and at 1 s, one look without them in between.
+    # Four looks with retries at 0 s and at 1 s, one look without them in between.
     retried = [round(t or 0.0, 1) for t, _, retry in never.seen if retry]
-    assert retried == [0.0, 0.0, 1.0, 1.0] and len(never.seen) == 12 + 2
+    assert retried == [0.0] * 4 + [1.0] * 4 and len(never.seen) == 12 + 6
 
 
 @pytest.fixture(scope="module")

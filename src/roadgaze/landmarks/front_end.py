@@ -60,12 +60,13 @@ STRONG_COLOUR_SIGMA = 2.0
 """... and by the difference of their levels with this many times the measured noise: the
 noise is flattened, a face's edges (several noise levels high) are kept."""
 WIDE_DIAMETER_PX = 13
-"""The `wide` smoothing, the last further look: a bilateral filter this many pixels across, ..."""
+"""The `wide` look, the last: a bilateral filter this many pixels across, ..."""
 WIDE_SPACE_SIGMA_PX = 5.0
 """... with this spatial standard deviation ..."""
 WIDE_COLOUR_SIGMA = 3.0
-"""... and this many times the measured noise: for noise too strong for `strong` (on the dev
-subjects under harder IR-like and dark transforms than the suite's, docs/conditions.md)."""
+"""... and this many times the measured noise, then at the coarse scale (`COARSE_FACTOR`): for
+noise too strong for `strong` (on the dev subjects under harder IR-like and dark transforms than
+the suite's, docs/conditions.md)."""
 COARSE_FACTOR = 2
 """The `coarse` look, after `strong`: the `strong` version averaged over blocks of this many
 pixels square and scaled back (the frame at a coarser scale: noise falls by this factor again)."""
@@ -176,6 +177,8 @@ BILATERAL: dict[Version, tuple[int, float, float]] = {
 }
 """The versions smoothed by a bilateral filter: (diameter px, space sigma px, colour sigma in
 noise levels)."""
+COARSE: frozenset[Version] = frozenset(("coarse", "wide"))
+"""The versions then averaged over `COARSE_FACTOR` pixels square and scaled back."""
 
 
 def _enhanced(
@@ -194,7 +197,7 @@ def _enhanced(
         size = (SMOOTHING_KERNEL_PX, SMOOTHING_KERNEL_PX)
         grey = np.asarray(cv2.GaussianBlur(grey, size, 0), np.uint8)
     curved = np.asarray(cv2.LUT(grey, tone_curve(levels)), np.uint8)
-    if version == "coarse" and levels.noise >= NOISY_LEVELS:
+    if version in COARSE and levels.noise >= NOISY_LEVELS:
         height, width = curved.shape
         small = (max(width // COARSE_FACTOR, 1), max(height // COARSE_FACTOR, 1))
         shrunk = cv2.resize(curved, small, interpolation=cv2.INTER_AREA)
@@ -210,8 +213,8 @@ def enhance(
     `NOISY_LEVELS` or more, through its tone curve (the levels and the noise measured on the
     luminance). The smoothing is a `SMOOTHING_KERNEL_PX` Gaussian, or with `strong` (`version`
     "strong") an edge-preserving bilateral filter (`STRONG_DIAMETER_PX`; about 30 times the
-    Gaussian's CPU, so only for a further look); `version` "wide" a wider one
-    (`WIDE_DIAMETER_PX`), "coarse" the strong one at half the scale (`COARSE_FACTOR`). A frame
+    Gaussian's CPU, so only for a further look); `version` "coarse" the strong one at half the
+    scale (`COARSE_FACTOR`), "wide" a wider one (`WIDE_DIAMETER_PX`) at half the scale. A frame
     without noise gets the curve alone in every version."""
     return _enhanced(image, version or ("strong" if strong else "curve"))[0]
 

@@ -215,6 +215,21 @@ def test_strong_smoothing_flattens_the_noise_and_keeps_an_edge() -> None:
     assert abs(float(strong.mean()) - float(gaussian.mean())) < 3.0
     clean = enhance(FLAT)  # no noise: no smoothing, the strong version is the same
     np.testing.assert_array_equal(enhance(FLAT, strong=True), clean)
+    for version in ("coarse", "wide"):  # and so are the further ones
+        np.testing.assert_array_equal(enhance(FLAT, version=version), clean)
+
+
+def test_the_coarse_look_is_the_strong_one_at_half_the_scale() -> None:
+    """`coarse`: the strong version's 2x2 block means, scaled back: on the step frame the rows
+    keep their level, less grain is left, and the step spreads over a few pixels only."""
+    step = np.where(np.arange(640) < 320, 110, 150)[None, :] * np.ones((480, 1))
+    frame = noisy(step)
+    strong, coarse = enhance(frame, strong=True), enhance(frame, version="coarse")
+    assert coarse.shape == strong.shape
+    assert grain(coarse) < 0.75 * grain(strong)
+    assert abs(float(coarse.mean()) - float(strong.mean())) < 1.0
+    rows = slice(100, 380)
+    assert float(coarse[rows, 324].mean() - coarse[rows, 315].mean()) > 120
 
 
 def test_a_noisy_hard_still_is_looked_at_ever_more_smoothly_with_retries() -> None:

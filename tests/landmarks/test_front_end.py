@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from fakes import ListSource, face_at
+from repo_paths import POINTING04
 from roadgaze.landmarks.front_end import (
     DARK_MEAN,
     FLAT_SPREAD,
@@ -310,3 +311,27 @@ def test_a_frame_too_small_for_a_noise_row_is_assessed_and_enhanced(
     levels = assess(frame, noise=True)
     assert levels.noise == 0.0 and levels.mean == 0.0
     assert enhance(frame).shape[:2] == shape[:2]
+
+
+@pytest.mark.skipif(not POINTING04.is_dir(), reason=f"no data at {POINTING04}")
+def test_a_face_in_very_dark_noisy_light_is_found_only_at_the_coarse_scale() -> None:
+    """A dev still under dark light harder than the suite's (gain 0.1, noise 5): the LiteRT
+    landmarker with its retries finds no face in the enhanced or the strong version, and the
+    front end finds it in a further look, at a plausible size."""
+    from roadgaze.config import Config, ModelConfig
+    from roadgaze.evaluation.conditions import apply_condition
+    from roadgaze.evaluation.images import read_image
+    from roadgaze.landmarks.landmarker import Landmarker
+    from roadgaze.landmarks.model_store import resolve_model
+
+    name = "images/Person01/person01119-30-15.jpg"
+    frame = apply_condition("dark:gain=0.1,noise_std=5", read_image(POINTING04 / name), None, name)
+    model = resolve_model(ModelConfig(), environ={})
+    with Landmarker(Config().landmarks, model, video=False) as landmarker:
+        for version in ("curve", "strong"):
+            prepared = landmarker.prepare(enhance(frame, version=version))  # type: ignore[arg-type]
+            assert not landmarker.infer(prepared, retry_rejected=True).faces
+        front_end = FrontEndDetector(landmarker)
+        assert front_end.looks(front_end.prepare(frame))[2:] == ("coarse", "wide")
+        driver = front_end.detect(frame).driver
+    assert driver is not None and 60 < driver.x_right_px - driver.x_left_px < 200

@@ -71,8 +71,8 @@ COARSE_FACTOR = 2
 """The `coarse` look, after `strong`: the `strong` version averaged over blocks of this many
 pixels square and scaled back (the frame at a coarser scale: noise falls by this factor again)."""
 RETRY_STEP_S = 1e-4
-"""In a stream, the second look at a frame is passed as taken this much later (the detector
-needs strictly increasing times)."""
+"""In a stream, each further look at a frame is passed as taken this much later than the one
+before (the detector needs strictly increasing times)."""
 HOLD_S = 2.0
 """In a stream, after a second look found the face, frames take its version for this long."""
 RETRY_WAIT_S = 1.0
@@ -167,9 +167,9 @@ def tone_curve(levels: FrameLevels) -> npt.NDArray[np.uint8]:
     return np.asarray(np.rint(255.0 * ramp**gamma), np.uint8)
 
 
-Version = Literal["plain", "curve", "strong", "wide", "coarse"]
+Version = Literal["plain", "curve", "strong", "coarse", "wide"]
 """A frame's version for the detector: as it came, `enhance`d, or `enhance`d with a stronger
-smoothing (`strong`, `wide`, `coarse`: further looks at a noisy hard frame)."""
+smoothing (`strong`, `coarse`, `wide`: further looks at a noisy hard frame)."""
 BILATERAL: dict[Version, tuple[int, float, float]] = {
     "strong": (STRONG_DIAMETER_PX, STRONG_SPACE_SIGMA_PX, STRONG_COLOUR_SIGMA),
     "coarse": (STRONG_DIAMETER_PX, STRONG_SPACE_SIGMA_PX, STRONG_COLOUR_SIGMA),

@@ -6,7 +6,7 @@
 Frames: a good colour frame (the decision only), and a dark colour frame, a flat grey frame
 (V4L2 GREY) and a noisy IR-like grey frame (the decision and the enhancement), each made from
 skimage's astronaut placed on a 640x480 canvas with the condition suite's transforms; then the
-strong version a further look makes of the two noisy ones (N / 10 frames a round). Prints the
+versions further looks make of the two noisy ones (N / 10 frames a round). Prints the
 process CPU time per frame (median of 5 rounds of N frames), so other processes on the machine
 move it less than wall time.
 """
@@ -22,7 +22,7 @@ import numpy as np
 from skimage import data as skimage_data
 
 from roadgaze.evaluation.conditions import dark_cabin, ir_grey
-from roadgaze.landmarks.front_end import assess, enhance
+from roadgaze.landmarks.front_end import Version, assess, enhance
 
 
 def canvas() -> np.ndarray:
@@ -32,16 +32,16 @@ def canvas() -> np.ndarray:
     return frame
 
 
-def cost_ms(frame: np.ndarray, frames: int, strong: bool = False) -> tuple[float, bool]:
-    """Median CPU ms per frame of the front end's work on `frame` (with `strong`, of the strong
-    version a further look makes), and whether it enhanced."""
+def cost_ms(frame: np.ndarray, frames: int, version: Version = "curve") -> tuple[float, bool]:
+    """Median CPU ms per frame of the front end's work on `frame` (with another `version`, of
+    the version a further look makes), and whether it enhanced."""
     needs = assess(frame).needs_curve
     rounds = []
     for _ in range(5):
         start = time.process_time()
         for _ in range(frames):
             if assess(frame).needs_curve:
-                enhance(frame, strong=strong)
+                enhance(frame, version=version)
         rounds.append((time.process_time() - start) / frames * 1e3)
     return statistics.median(rounds), needs
 
@@ -64,10 +64,12 @@ def main() -> int:
         milliseconds, enhanced = cost_ms(frame, args.frames)
         what = "decision + enhancement" if enhanced else "decision only"
         print(f"  {name:30s} {milliseconds:.3f} ms ({what})")
-    print("a further look's strong version (a noisy hard frame without a face at first):")
+    print("a further look's versions (a noisy hard frame without a face at first):")
+    further: tuple[Version, ...] = ("strong", "coarse", "wide")
     for name in ("dark colour frame", "IR-like grey frame (noise 6)"):
-        milliseconds, _ = cost_ms(cases[name], max(1, args.frames // 10), strong=True)
-        print(f"  {name:30s} {milliseconds:.3f} ms (decision + strong enhancement)")
+        for version in further:
+            milliseconds, _ = cost_ms(cases[name], max(1, args.frames // 10), version)
+            print(f"  {name:30s} {milliseconds:.3f} ms (decision + {version} enhancement)")
     return 0
 
 

@@ -14,12 +14,12 @@ detector untouched: the decision is all it costs.
 
 `landmarks.enhance`:
 - `auto` (default): the rule above; and when the detector finds no face, the frame is looked at
-  once more in its other version (`FrontEndDetector.infer`);
+  again in its other versions (`FrontEndDetector.looks`: a noisy hard frame ever more smoothly);
 - `off`: frames go to the detector as they come;
 - `always`: every frame is enhanced.
 
-The rule and its constants were chosen on Pointing'04 subjects 1-10, all together, with the
-condition suite (docs/conditions.md).
+The rule and its constants were chosen on Pointing'04 subjects 1-10 with the condition suite,
+the further looks leaving one subject out at a time (docs/conditions.md).
 """
 
 from __future__ import annotations
@@ -59,9 +59,20 @@ STRONG_SPACE_SIGMA_PX = 3.0
 STRONG_COLOUR_SIGMA = 2.0
 """... and by the difference of their levels with this many times the measured noise: the
 noise is flattened, a face's edges (several noise levels high) are kept."""
+WIDE_DIAMETER_PX = 13
+"""The `wide` look, the last: a bilateral filter this many pixels across, ..."""
+WIDE_SPACE_SIGMA_PX = 5.0
+"""... with this spatial standard deviation ..."""
+WIDE_COLOUR_SIGMA = 3.0
+"""... and this many times the measured noise, then at the coarse scale (`COARSE_FACTOR`): for
+noise too strong for `strong` (on the dev subjects under harder IR-like and dark transforms than
+the suite's, docs/conditions.md)."""
+COARSE_FACTOR = 2
+"""The `coarse` look, after `strong`: the `strong` version averaged over blocks of this many
+pixels square and scaled back (the frame at a coarser scale: noise falls by this factor again)."""
 RETRY_STEP_S = 1e-4
-"""In a stream, the second look at a frame is passed as taken this much later (the detector
-needs strictly increasing times)."""
+"""In a stream, each further look at a frame is passed as taken this much later than the one
+before (the detector needs strictly increasing times)."""
 HOLD_S = 2.0
 """In a stream, after a second look found the face, frames take its version for this long."""
 RETRY_WAIT_S = 1.0
@@ -156,38 +167,56 @@ def tone_curve(levels: FrameLevels) -> npt.NDArray[np.uint8]:
     return np.asarray(np.rint(255.0 * ramp**gamma), np.uint8)
 
 
+Version = Literal["plain", "curve", "strong", "coarse", "wide"]
+"""A frame's version for the detector: as it came, `enhance`d, or `enhance`d with a stronger
+smoothing (`strong`, `coarse`, `wide`: further looks at a noisy hard frame)."""
+BILATERAL: dict[Version, tuple[int, float, float]] = {
+    "strong": (STRONG_DIAMETER_PX, STRONG_SPACE_SIGMA_PX, STRONG_COLOUR_SIGMA),
+    "coarse": (STRONG_DIAMETER_PX, STRONG_SPACE_SIGMA_PX, STRONG_COLOUR_SIGMA),
+    "wide": (WIDE_DIAMETER_PX, WIDE_SPACE_SIGMA_PX, WIDE_COLOUR_SIGMA),
+}
+"""The versions smoothed by a bilateral filter: (diameter px, space sigma px, colour sigma in
+noise levels)."""
+COARSE: frozenset[Version] = frozenset(("coarse", "wide"))
+"""The versions then averaged over `COARSE_FACTOR` pixels square and scaled back."""
+
+
 def _enhanced(
-    image: npt.NDArray[np.uint8], strong: bool = False
+    image: npt.NDArray[np.uint8], version: Version = "curve"
 ) -> tuple[npt.NDArray[np.uint8], FrameLevels]:
     """`enhance`, and the levels and noise of the frame's luminance."""
     import cv2
 
     grey = _luminance(image)
     levels = assess(grey, noise=True)  # on the luminance (the decision read a colour's green)
-    if levels.noise >= NOISY_LEVELS and strong:
-        sigma_colour = STRONG_COLOUR_SIGMA * levels.noise
-        grey = np.asarray(
-            cv2.bilateralFilter(grey, STRONG_DIAMETER_PX, sigma_colour, STRONG_SPACE_SIGMA_PX),
-            np.uint8,
-        )
+    if levels.noise >= NOISY_LEVELS and version in BILATERAL:
+        diameter, space_sigma, colour_sigma = BILATERAL[version]
+        sigma_colour = colour_sigma * levels.noise
+        grey = np.asarray(cv2.bilateralFilter(grey, diameter, sigma_colour, space_sigma), np.uint8)
     elif levels.noise >= NOISY_LEVELS:
         size = (SMOOTHING_KERNEL_PX, SMOOTHING_KERNEL_PX)
         grey = np.asarray(cv2.GaussianBlur(grey, size, 0), np.uint8)
-    return np.asarray(cv2.LUT(grey, tone_curve(levels)), np.uint8), levels
+    curved = np.asarray(cv2.LUT(grey, tone_curve(levels)), np.uint8)
+    if version in COARSE and levels.noise >= NOISY_LEVELS:
+        height, width = curved.shape
+        small = (max(width // COARSE_FACTOR, 1), max(height // COARSE_FACTOR, 1))
+        shrunk = cv2.resize(curved, small, interpolation=cv2.INTER_AREA)
+        curved = np.asarray(cv2.resize(shrunk, (width, height), interpolation=cv2.INTER_LINEAR))
+    return curved, levels
 
 
-def enhance(image: npt.NDArray[np.uint8], strong: bool = False) -> npt.NDArray[np.uint8]:
+def enhance(
+    image: npt.NDArray[np.uint8], strong: bool = False, version: Version | None = None
+) -> npt.NDArray[np.uint8]:
     """`image` as the detector should see it, in one grey channel (a dark frame's colour carries
     little, and one channel costs a third): its luminance, smoothed when its noise is
     `NOISY_LEVELS` or more, through its tone curve (the levels and the noise measured on the
-    luminance). The smoothing is a `SMOOTHING_KERNEL_PX` Gaussian, or with `strong` an
-    edge-preserving bilateral filter (`STRONG_DIAMETER_PX`; about 30 times the Gaussian's CPU,
-    so only for a second look)."""
-    return _enhanced(image, strong)[0]
-
-
-Version = Literal["plain", "curve", "strong"]
-"""A frame's version for the detector: as it came, `enhance`d, or `enhance`d `strong`."""
+    luminance). The smoothing is a `SMOOTHING_KERNEL_PX` Gaussian, or with `strong` (`version`
+    "strong") an edge-preserving bilateral filter (`STRONG_DIAMETER_PX`; about 30 times the
+    Gaussian's CPU, so only for a further look); `version` "coarse" the strong one at half the
+    scale (`COARSE_FACTOR`), "wide" a wider one (`WIDE_DIAMETER_PX`) at half the scale. A frame
+    without noise gets the curve alone in every version."""
+    return _enhanced(image, version or ("strong" if strong else "curve"))[0]
 
 
 @dataclass(frozen=True, slots=True)
@@ -285,10 +314,11 @@ class FrontEndDetector(ClosesOnExit):
     @staticmethod
     def looks(prepared: FrontEndPrepared) -> tuple[Version, ...]:
         """The versions `auto` tries in turn until one has a face: a good frame as it came, then
-        enhanced; a hard one enhanced, then (when noisy) enhanced `strong`, then as it came."""
+        enhanced; a hard one enhanced, then (when noisy) enhanced ever more smoothly, `strong`,
+        `coarse`, `wide` (the dearest last), else as it came."""
         if not prepared.hard:
             return ("plain", "curve")
-        return ("curve", "strong") if prepared.noisy else ("curve", "plain")
+        return ("curve", "strong", "coarse", "wide") if prepared.noisy else ("curve", "plain")
 
     def infer(self, prepared: FrontEndPrepared, t_s: float | None = None) -> FrontEndInference:
         """The detector on the prepared frame. In `auto` mode, when it finds no face, on the
@@ -336,7 +366,7 @@ class FrontEndDetector(ClosesOnExit):
         if version == "plain":
             return self._inner_prepare(prepared.image), 0.0
         start = time.perf_counter()
-        image = enhance(prepared.image, strong=version == "strong")
+        image = enhance(prepared.image, version=version)
         return self._inner_prepare(image), (time.perf_counter() - start) * 1e3
 
     def measure(self, inference: FrontEndInference) -> Detection:

@@ -8,7 +8,8 @@
 #
 #   sudo docker/smoke.sh                     (from anywhere in a clone; podman, else docker)
 #
-# Needs root (or a working rootless podman/docker) and a few minutes; not part of .ci/run.
+# Needs root (or a working rootless podman/docker) and a few minutes; .ci/run runs it where
+# podman works.
 #
 # Settings (environment):
 #   ENGINE=podman|docker     default: podman if installed, else docker

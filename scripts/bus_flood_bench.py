@@ -7,7 +7,8 @@ For every round, tree and flood (10 MB puts on the speed key as fast as a client
 state queries a second; the same two on another vehicle's keys, which the daemon does not
 declare: what the router and the flooder alone cost on a shared machine) it starts, each in its
 own process: a Python router on a free loopback port, the daemon's bus outputs and frame loop
-from that tree (`bus_outputs` + `Pipeline`, real MediaPipe on a synthetic clip by default), and
+from that tree (`build_run` as `roadgaze run` builds it, or `bus_outputs` + `Pipeline` in a tree
+from before it; real MediaPipe on a synthetic clip by default), and
 the flooder. The flooder is switched on and off (SIGCONT/SIGSTOP) every `--period` seconds for
 `--cycles` cycles, so each flooded window has an unflooded neighbour in the same process: the
 other load on a shared machine drifts more slowly than that. The daemon records the wall time
@@ -106,8 +107,7 @@ def run_daemon(args: argparse.Namespace) -> int:
 
     from roadgaze.capture import LoopingSource, VideoFileSource
     from roadgaze.config import Config
-    from roadgaze.daemon import bus_outputs
-    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.pipeline import create_detector
     from roadgaze.types import Detection
 
     config = Config.model_validate(
@@ -136,6 +136,9 @@ def run_daemon(args: argparse.Namespace) -> int:
         def on_record(self, record: Any, frame: Any) -> None:
             self.stamps.append((time.monotonic(), time.process_time()))
 
+        def on_alert(self, alert: Any) -> None:
+            return None
+
         def close(self) -> None:
             return None
 
@@ -144,15 +147,33 @@ def run_daemon(args: argparse.Namespace) -> int:
     stop = threading.Event()
     threading.Thread(target=lambda: (sys.stdin.readline(), stop.set()), daemon=True).start()
     source = LoopingSource(lambda: VideoFileSource(Path(args.clip)), duration_s=600.0)
+    try:
+        from roadgaze.pipeline import RunOptions, build_run
+    except ImportError:  # a tree from before the one builder: its daemon's own wiring
+        state = old_tree_loop(config, detector, source, times, stop)
+    else:
+        options = RunOptions("bench", command="run", publish=True)
+        with build_run(config, options, source=source, detector=detector, sinks=(times,)) as run:
+            print("ready", flush=True)
+            run.run(stop=stop)
+            state = run.health.state_message().transport.model_dump()
+    counters = {k: v for k, v in state.items() if isinstance(v, int) and not isinstance(v, bool)}
+    print(json.dumps({"stamps": times.stamps, "transport": counters}), flush=True)
+    return 0
+
+
+def old_tree_loop(config: Any, detector: Any, source: Any, times: Any, stop: Any) -> Any:
+    """The loop as a tree without `roadgaze.pipeline.build_run` wired it (`roadgaze.daemon`)."""
+    from roadgaze.daemon import bus_outputs
+    from roadgaze.pipeline import Pipeline
+
     with bus_outputs(config, "bench", publish=True) as bus:
         pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
         print("ready", flush=True)
         pipeline.run(source, [*bus.sinks, times], stop=stop)
         state = bus.health.state_message().transport.model_dump()
     detector.close()
-    counters = {k: v for k, v in state.items() if isinstance(v, int) and not isinstance(v, bool)}
-    print(json.dumps({"stamps": times.stamps, "transport": counters}), flush=True)
-    return 0
+    return state
 
 
 def spawn(code_or_args: list[str], env: dict[str, str] | None = None) -> subprocess.Popen[str]:

@@ -2,7 +2,7 @@
 
     PYTHONPATH=src python scripts/compare-engines.py CLIP [--baseline]
 
-Runs the pipeline (`Pipeline.from_config`, the configured settings but `landmarks.engine`) over
+Runs the pipeline (`build_run`, the configured settings but `landmarks.engine`) over
 CLIP once with `litert` and once with `mediapipe` and prints, over the frames where both found
 the driver, the median, p99 and largest absolute difference of the raw and smoothed yaw and
 pitch, MediaPipe's matrix yaw and pitch, the eye direction and openness, the driver's landmarks
@@ -24,8 +24,8 @@ import numpy as np
 
 from roadgaze.capture import open_source
 from roadgaze.config import Config
-from roadgaze.pipeline import Pipeline, create_detector
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.pipeline import RunOptions, build_run
+from roadgaze.types import ClosesOnExit, Frame, FrameRecord
 
 FIELDS: dict[str, Callable[[FrameRecord], Any]] = {
     "yaw_raw_deg": lambda r: r.sample.yaw_raw_deg,
@@ -40,7 +40,7 @@ FIELDS: dict[str, Callable[[FrameRecord], Any]] = {
 }
 
 
-class FlippedBits:
+class FlippedBits(ClosesOnExit):
     """A source whose frames have the lowest bit of a random 1 % of their pixels flipped."""
 
     def __init__(self, source: Any) -> None:
@@ -56,19 +56,19 @@ class FlippedBits:
     def __getattr__(self, name: str) -> Any:
         return getattr(self._source, name)
 
+    def close(self) -> None:
+        self._source.close()
+
 
 def run(clip: str, engine: str, perturb: bool) -> list[FrameRecord]:
     base = Config()
     landmarks = base.landmarks.model_copy(update={"engine": engine})
     config = base.model_copy(update={"landmarks": landmarks})
-    with open_source(clip, config) as source:
-        detector = create_detector(config)
-        try:
-            pipeline = Pipeline.from_config(config, detector)
-            frames = FlippedBits(source) if perturb else source
-            return [processed.record for processed in pipeline.frames(frames)]
-        finally:
-            detector.close()
+    source = open_source(clip, config)
+    options = RunOptions(clip, command="compare-engines", quiet=True)
+    frames = FlippedBits(source) if perturb else source
+    with build_run(config, options, source=frames) as built:
+        return [processed.record for processed in built.frames()]
 
 
 def main() -> int:

@@ -4,12 +4,13 @@
     .venv/bin/python scripts/compare-speed.py VIDEO --trees OLD/src NEW/src [--rounds 3]
 
 Each round runs one child process per tree (alternating which goes first), with the tree first
-on PYTHONPATH. A child does what `roadgaze bench` does, with code of its own so that any tree
-can be measured the same way: MediaPipe's FaceLandmarker alone on the clip (VIDEO mode, one face,
-frames decoded first, only `detect_for_video` timed), then the tree's `Pipeline.run` over the
-clip with no outputs (frames per second after a warm-up), then MediaPipe alone again; the ratio
-is the pipeline's fps over the mean of the two raw passes, the median ratio the raw passes'
-median call time over the pipeline's median time between frames (load spikes move it less).
+on PYTHONPATH. A child does what `roadgaze bench` does: MediaPipe's FaceLandmarker alone on the
+clip (VIDEO mode, one face, frames decoded first, only `detect_for_video` timed; code of its own,
+the same for any tree), then the tree's loop over the clip with no outputs as its bench builds it
+(`build_run`; `Pipeline.run` in a tree from before it), frames per second after a warm-up, then
+MediaPipe alone again; the ratio is the pipeline's fps over the mean of the two raw passes, the
+median ratio the raw passes' median call time over the pipeline's median time between frames
+(load spikes move it less).
 Every run is printed (a shared machine's load moves single runs), then the medians; progress on
 stderr, the table on stdout.
 """
@@ -84,6 +85,9 @@ class Throughput:
             self.intervals.append(now[0] - previous[0])
             self.last = now
 
+    def on_alert(self, alert: Any) -> None:
+        return None
+
     def close(self) -> None:
         return None
 
@@ -93,16 +97,23 @@ def child(video: str) -> None:
     from roadgaze.capture import open_source
     from roadgaze.config import Config
     from roadgaze.landmarks.model_store import resolve_model
-    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.pipeline import Pipeline, create_detector  # a tree from before the builder
 
     config = Config()
     model = str(resolve_model(config.model))
     before, before_cpu, before_median = raw_fps(video, model)
     probe = Throughput()
-    detector = create_detector(config)
-    with open_source(video, config) as source:
-        summary = Pipeline.from_config(config, detector).run(source, [probe])
-    detector.close()
+    try:
+        from roadgaze.pipeline import RunOptions, build_run
+    except ImportError:  # a tree from before the one builder: the loop as its bench ran it
+        detector = create_detector(config)
+        with open_source(video, config) as source:
+            summary = Pipeline.from_config(config, detector).run(source, [probe])
+        detector.close()
+    else:
+        options = RunOptions(video, command="bench", quiet=True)
+        with build_run(config, options, sinks=(probe,)) as run:
+            summary = run.run()
     after, after_cpu, after_median = raw_fps(video, model)
     assert probe.start is not None and probe.last is not None
     frames = probe.seen - WARMUP - 1

@@ -37,7 +37,6 @@ HERE = Path(__file__).resolve()
 DATA = Path(os.environ.get("ROADGAZE_DATA") or HERE.parents[2] / "shared" / "data")
 sys.path.insert(0, str(HERE.parents[1] / "src"))
 
-from roadgaze.capture.open import open_source  # noqa: E402
 from roadgaze.config import Config  # noqa: E402
 from roadgaze.evaluation import load_ground_truth  # noqa: E402
 from roadgaze.evaluation.images import StillPose, read_image  # noqa: E402
@@ -45,7 +44,7 @@ from roadgaze.landmarks.eyes import driver_eyes  # noqa: E402
 from roadgaze.landmarks.landmarker import MediaPipeLandmarker  # noqa: E402
 from roadgaze.landmarks.model_store import resolve_model  # noqa: E402
 from roadgaze.monitor.eye_calibration import thresholds_deg  # noqa: E402
-from roadgaze.pipeline import Pipeline, create_detector  # noqa: E402
+from roadgaze.pipeline import RunOptions, build_run  # noqa: E402
 
 GIFS = (
     "head-pose-face-detection-male.gif",
@@ -104,15 +103,10 @@ def stills(dataset: Path, config: Config) -> dict[str, Any]:
 
 def video(path: Path, config: Config) -> dict[str, Any]:
     """The eye direction over one clip through the whole pipeline (see the module doc)."""
-    detector = create_detector(config)
-    try:
-        pipeline = Pipeline.from_config(config, detector)
-        records = []
-        with open_source(str(path), config) as source:
-            for frame in source:
-                records.append(pipeline.process(frame).record)
-    finally:
-        detector.close()
+    options = RunOptions(str(path), command="eye-noise", quiet=True)
+    with build_run(config, options) as run:
+        records = [processed.record for processed in run.frames()]
+    pipeline = run.pipeline
     yaws, pitches, any_pitches = [], [], []
     for record in records:
         sample, eyes = record.sample, record.verdict.eyes

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.metadata
+import itertools
 import json
 import os
 import platform
@@ -165,7 +166,10 @@ def condition_tables() -> str | None:
             "--set",
             f"landmarks.enhance={mode}",
         ).stdout
-        table = [line for line in output.splitlines() if line.startswith("|")]
+        lines = output.splitlines()
+        first = next((i for i, line in enumerate(lines) if line.startswith("|")), len(lines))
+        # The first table (the per-subject one follows it after a blank line).
+        table = list(itertools.takewhile(lambda line: line.startswith("|"), lines[first:]))
         parts += [
             f"`landmarks.enhance = {mode}` (`roadgaze eval $ROADGAZE_DATA/pointing04-dev "
             f"--condition all --set landmarks.enhance={mode}`, "

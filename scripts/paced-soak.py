@@ -3,9 +3,9 @@
 
     .venv/bin/python scripts/paced-soak.py VIDEO SECONDS
 
-Loops VIDEO for SECONDS through `Pipeline.run(..., realtime=True)`, the one-thread path a camera
-or `roadgaze run --source FILE` takes, with the service's Zenoh outputs (health and publisher, a
-peer listening on a free 127.0.0.1 port, no subscriber needed), and prints the resident memory
+Loops VIDEO for SECONDS through the run `roadgaze run` builds (`build_run`: health, publisher, a
+peer listening on a free 127.0.0.1 port, no subscriber needed) paced at the video's rate, the
+one-thread path a camera or `roadgaze run --source FILE` takes, and prints the resident memory
 baseline (after 30 s), end, peak and growth. `roadgaze bench --loop-seconds S --memory` measures
 the flat-out path.
 """
@@ -13,25 +13,20 @@ the flat-out path.
 from __future__ import annotations
 
 import sys
-from contextlib import closing
 
 from roadgaze.benchmark.probes import MemoryProbe
 from roadgaze.capture import LoopingSource, VideoFileSource
 from roadgaze.config import Config
-from roadgaze.daemon import bus_outputs
 from roadgaze.demo import demo_config, free_local_port
 from roadgaze.errors import RoadgazeError
-from roadgaze.pipeline import Pipeline, RunSummary, create_detector
+from roadgaze.pipeline import RunOptions, RunSummary, build_run
 
 
 def soak(video: str, seconds: float, config: Config, memory: MemoryProbe) -> RunSummary:
-    with (
-        bus_outputs(config, "paced-soak", publish=True) as bus,
-        closing(create_detector(config)) as detector,
-        LoopingSource(lambda: VideoFileSource(video), duration_s=seconds) as source,
-    ):
-        pipeline = Pipeline.from_config(config, detector)
-        summary = pipeline.run(source, [*bus.sinks, memory], realtime=True)
+    source = LoopingSource(lambda: VideoFileSource(video), duration_s=seconds)
+    options = RunOptions("paced-soak", command="run", publish=True)
+    with build_run(config, options, source=source, sinks=(memory,)) as run:
+        summary = run.run(realtime=True)
     memory.close()
     return summary
 

@@ -48,3 +48,15 @@ class FakeRunner:
         self.calls += [s.name for s in scenarios]
         failed = [r.key for s in scenarios if s.name in self.failing for r in s.requirements]
         return outcomes_of(scenarios, failed)
+
+
+def failing_under(*conditions: str, scenario: str = "microsleep_70") -> set[str]:
+    """`scenario` (the shortest GREEN drive, run first) under each of `conditions`: a
+    `FakeRunner` failing these shows those noise variables not functional."""
+    return {f"{scenario}__{condition}" for condition in conditions}
+
+
+MANDATORY = ("night", "clear_sunglasses", "stubble", "beard", "mask")
+"""The conditions of the five mandatory noise variables."""
+NOTICES = ("hand_at_12", "cap", "hat", "fringe", "eyelash_makeup")
+"""The conditions whose noise variables ask for a non-functional notice (dark sunglasses aside)."""

@@ -497,7 +497,8 @@ def test_signal_matrix(
             code = int(caught.value.code or 0)
         sender.join(timeout=30)
         elapsed_s = time.monotonic() - started
-        time.sleep(0.5)
+        if times == 1:  # the final state on its way to the hub (asserted below)
+            wait_for(lambda: [s["status"] for s in hub.of("state")][-1:] == ["stopped"], 10.0)
         hub.close()
     stderr = capsys.readouterr().err
     assert f"{name} received" in stderr
@@ -572,7 +573,10 @@ def test_run_and_listen_without_endpoint_flags_find_each_other(with_router: bool
         try:
             daemon_log = LineReader(daemon, daemon.stderr)
             lines = daemon_log.until("roadgaze run: source", 60.0)
-            time.sleep(1.0)
+            if not with_router:
+                time.sleep(1.0)  # nobody there: no "connected" may come meanwhile
+            elif not any("zenoh connected" in line for line in lines):
+                lines += daemon_log.until("zenoh connected", 30.0)  # the router is there
             while (line := daemon_log.next(0.1)) is not None:
                 lines.append(line)
             connected_alone = any("zenoh connected" in line for line in lines)
@@ -584,8 +588,7 @@ def test_run_and_listen_without_endpoint_flags_find_each_other(with_router: bool
             stdout, listen_log = listener.communicate(timeout=60)
             daemon.send_signal(signal.SIGTERM)
             assert daemon.wait(timeout=30) == 0
-            while (line := daemon_log.next(1.0)) is not None:
-                lines.append(line)
+            lines += daemon_log.rest()
         finally:
             stop_process(daemon)
             if listener is not None:

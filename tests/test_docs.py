@@ -46,6 +46,16 @@ def test_no_file_a_user_has_points_outside_the_repository() -> None:
     assert found == []
 
 
+def test_ci_runs_the_readmes_test_command_exactly() -> None:
+    """The README's second command (install and run the tests, in parallel) is the line
+    `.ci/run` runs, so what a user types is what CI checks."""
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    commands = re.findall(r"^python3 -m venv .*$", readme, flags=re.MULTILINE)
+    assert len(commands) >= 2 and "pytest -n auto" in commands[1], commands
+    ci_lines = (REPO / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+    assert commands[1] in ci_lines
+
+
 def test_tests_find_the_evaluation_data_in_one_place() -> None:
     """Only tests/repo_paths.py knows where the data is ($ROADGAZE_DATA, else beside the
     development checkout)."""

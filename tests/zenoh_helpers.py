@@ -87,6 +87,15 @@ class LineReader:
         except queue.Empty:
             return None
 
+    def rest(self, timeout_s: float = 30.0) -> list[str]:
+        """The lines still to come up to the end of the stream (the process has ended, or is
+        ending): waits for the stream to close, not for a quiet spell; at most `timeout_s`."""
+        self._thread.join(timeout_s)
+        lines: list[str] = []
+        while (line := self.next(0.0)) is not None:
+            lines.append(line)
+        return lines
+
     def until(self, text: str, timeout_s: float) -> list[str]:
         """The lines read up to and including the first containing `text`; AssertionError when
         none comes within `timeout_s`."""
@@ -219,6 +228,20 @@ class AdvancedListener:
     def close(self) -> None:
         self.miss_listener.undeclare()
         self.subscriber.undeclare()
+
+
+def advanced_publisher(session: zenoh.Session, key: str) -> Any:
+    """An advanced publisher on `key` as the daemon declares its alert publisher (a cache,
+    sample-miss detection, publisher detection): a second publisher of a vehicle's alerts."""
+    from zenoh.ext import CacheConfig, MissDetectionConfig, declare_advanced_publisher
+
+    return declare_advanced_publisher(
+        session,
+        key,
+        cache=CacheConfig(max_samples=10),
+        sample_miss_detection=MissDetectionConfig(heartbeat=0.5),  # type: ignore[call-arg]
+        publisher_detection=True,
+    )
 
 
 if __name__ == "__main__":

@@ -1,159 +1,74 @@
-"""Every roadgaze alert of one vehicle, once, in order, checked (needs only eclipse-zenoh 1.x).
+"""Every roadgaze alert of one vehicle, once, in order, checked: the input of an FCW.
 
     python consume_alerts.py car-42 tcp/127.0.0.1:7447           # development: plain TCP
     python consume_alerts.py car-42 consumer-fcw/zenoh.json5       # `roadgaze security init` file
 
-It may start before the router or the daemon (an FCW boots first): it waits for them. The
-advanced subscriber's history gives the daemon's last alerts when it joins (and when a daemon
-appears later); recovery fetches, from the daemon's cache, alerts missed while a link was down.
-Each alert is checked: size, JSON, schema, vehicle id, seq continuing its publisher's sequence
-(a restarted daemon is a new publisher and starts at 0). Missing numbers are reported as a
-range (`MISSED #0-#2`); alerts from a second publisher of this vehicle (another Zenoh session,
-or a plain put) are flagged every time and not used; the totals are printed at exit.
+It may start before the router or the daemon (an FCW boots first): it waits for them.
+roadgaze's `AlertConsumer` does the work `roadgaze listen` does: the advanced subscriber's
+history gives the daemon's last alerts when it joins (and when a daemon appears later), recovery
+fetches alerts missed while a link was down, and each alert is checked (size, JSON, schema,
+vehicle id, seq continuing its publisher's sequence). Missing numbers come as a range, a plain
+put is refused, and when a second process publishes this vehicle's alerts both are handed on,
+flagged (on an open bus either may be the forger: never drop a real alert); totals at exit.
 """
 
-import json
-import queue
+import logging
+import math
 import sys
 import time
+from pathlib import Path
 
-import zenoh
-from zenoh.ext import HistoryConfig, RecoveryConfig, declare_advanced_subscriber
-
-MAX_BYTES = 64 * 1024
-KINDS = {
-    "long_distraction",
-    "vats",
-    "driver_unavailable",
-    "microsleep",
-    "sleep",
-    "drowsy",
-    "unresponsive",
-    "degraded",
-    "cleared",
-}
-LEVELS = {"info", "warning", "critical"}
+from roadgaze.config import ZenohConfig
+from roadgaze.errors import TransportError
+from roadgaze.transport import consumer_events as events
+from roadgaze.transport.consumer import AlertConsumer
 
 
-def session_config(target: str) -> zenoh.Config:
+def config_for(target: str) -> ZenohConfig:
     if target.endswith((".json5", ".json")):
-        return zenoh.Config.from_file(target)
-    settings = {
-        "mode": "client",  # consumers are clients: two peers meet only if one listens
-        "connect": {"endpoints": [target], "retry": {"period_init_ms": 250, "period_max_ms": 1000}},
-        "scouting": {"multicast": {"enabled": False}},
-    }
-    return zenoh.Config.from_json5(json.dumps(settings))
+        return ZenohConfig(config_file=Path(target))
+    return ZenohConfig(connect=[target])
 
 
-def open_when_reachable(target: str, deadline: float) -> zenoh.Session | None:
-    """A client cannot open before its router answers: try again every second."""
-    config, waiting = session_config(target), False
-    while True:
-        try:
-            return zenoh.open(config)
-        except zenoh.ZError as exc:
-            if time.monotonic() + 1.0 > deadline:
-                print(f"no router at {target}: {str(exc).split(' at /')[0]}", file=sys.stderr)
-                return None
-            if not waiting:
-                print(f"waiting for the router at {target}", file=sys.stderr, flush=True)
-                waiting = True
-            time.sleep(1.0)
+def act(event: events.ConsumerEvent) -> None:
+    """What the FCW does with each event: here, print it."""
+    match event:
+        case events.AlertReceived():  # a second publisher's too: flagged, never dropped
+            alert = event.alert
+            flag = f" SUSPICIOUS: {event.suspicious}" if event.suspicious else ""
+            print(f"{alert['kind']} {alert['level']} seq={event.seq} t={alert['t_s']:.2f}s{flag}")
+        case events.AlertsMissed() | events.AlertRefused() | events.SecondPublisher():
+            print(event.describe(), file=sys.stderr)
+        case events.MessageRejected() | events.DuplicateAlert():
+            print(f"refused an alert: {event}", file=sys.stderr)
+        case events.LinkLost():
+            print(f"{event.whatami} gone: zenoh reconnects by itself", file=sys.stderr)
+    sys.stdout.flush()
 
 
-def check(raw: bytes, vehicle_id: str) -> dict | str:
-    """The alert, or why it is refused; never raises on hostile bytes."""
-    if len(raw) > MAX_BYTES:
-        return f"{len(raw)} bytes"
-    try:
-        alert = json.loads(raw.decode("utf-8"))
-    except (RecursionError, UnicodeDecodeError, ValueError) as exc:
-        return f"not JSON ({type(exc).__name__})"
-    if not isinstance(alert, dict) or alert.get("schema") != "roadgaze.alert/3":
-        return "not a roadgaze.alert/3"
-    if alert.get("vehicle_id") != vehicle_id:
-        return "another vehicle's id"
-    if type(alert.get("seq")) is not int or alert["seq"] < 0:
-        return "no valid seq"
-    if alert.get("kind") not in KINDS or alert.get("level") not in LEVELS:
-        return "unknown kind or level"
-    if type(alert.get("t_s")) not in (int, float):
-        return "no valid t_s"
-    return alert
-
-
-def main(vehicle_id: str, target: str, seconds: float = float("inf")) -> None:
-    received: queue.Queue = queue.Queue(maxsize=10_000)
-
-    def on_alert(sample: zenoh.Sample) -> None:  # O(1): Zenoh's thread only hands over
-        source = str(sample.source_info.source_id) if sample.source_info else None
-        received.put(("alert", source, sample.payload.to_bytes()))
-
-    def on_alive(sample: zenoh.Sample) -> None:  # the daemon went: its successor is accepted
-        if sample.kind == zenoh.SampleKind.DELETE:
-            received.put(("left", None, b""))
-
-    next_seq: dict[str, int] = {}
-    totals = {"alerts": 0, "missed": 0, "rejected": 0, "foreign": 0}
-    publisher = None  # the vehicle's daemon: the first advanced publisher seen
+def main(vehicle_id: str, target: str, seconds: float = math.inf) -> None:
+    logging.basicConfig(level=logging.INFO, format="%(message)s")  # "waiting for a router ..."
     deadline = time.monotonic() + seconds
-    session = open_when_reachable(target, deadline)
-    if session is None:
+    try:
+        consumer = AlertConsumer.connect(config_for(target), vehicle_id, wait_s=seconds)
+    except TransportError as exc:
+        print(exc, file=sys.stderr)
         return
-    with session:
-        prefix = f"vehicle/{vehicle_id}/dms"
-        alive = session.liveliness().declare_subscriber(f"{prefix}/alive", on_alive)
-        subscriber = declare_advanced_subscriber(
-            session,
-            f"{prefix}/alert",
-            on_alert,
-            history=HistoryConfig(detect_late_publishers=True, max_samples=100),
-            recovery=RecoveryConfig(heartbeat=True),
-        )
-        misses = subscriber.sample_miss_listener(
-            lambda miss: received.put(("miss", str(miss.source), miss.nb))
-        )
+    with consumer:
         try:
-            while time.monotonic() < deadline:
-                try:
-                    what, source, data = received.get(timeout=0.2)
-                except queue.Empty:
-                    continue
-                if what == "left":
-                    publisher = None
-                    continue
-                if what == "miss":  # the range is printed with the next alert
-                    print(f"zenoh: {data} alerts missed", file=sys.stderr)
-                    continue
-                alert = check(data, vehicle_id)
-                if isinstance(alert, str):
-                    totals["rejected"] += 1
-                    print(f"refused an alert: {alert}", file=sys.stderr)
-                    continue
-                publisher = publisher or source
-                if source is None or source != publisher:
-                    totals["foreign"] += 1
-                    print(f"SUSPICIOUS: alert #{alert['seq']} from a second publisher "
-                          f"({source or 'a plain put'}); not used", file=sys.stderr)  # fmt: skip
-                    continue
-                expected = next_seq.get(source, 0)
-                if alert["seq"] < expected:
-                    continue  # already handled
-                if alert["seq"] > expected:  # never received: older than the daemon's cache
-                    totals["missed"] += alert["seq"] - expected
-                    print(f"MISSED #{expected}-#{alert['seq'] - 1}", file=sys.stderr)
-                next_seq[source] = alert["seq"] + 1
-                totals["alerts"] += 1
-                kind, level, seq, t_s = alert["kind"], alert["level"], alert["seq"], alert["t_s"]
-                print(f"{kind} {level} seq={seq} t={t_s:.2f}s", flush=True)
+            for event in consumer.events(deadline - time.monotonic()):
+                act(event)
         except KeyboardInterrupt:
             pass
-        finally:
-            misses.undeclare()
-            subscriber.undeclare()
-            alive.undeclare()
-            print(", ".join(f"{count} {name}" for name, count in totals.items()), file=sys.stderr)
+        for event in consumer.finish():
+            act(event)
+        book = consumer.book
+        print(
+            f"{book.printed} alerts, {book.flagged} flagged (a second publisher), "
+            f"{book.missed} missed, {book.rejected} rejected, {book.foreign - book.flagged} "
+            "refused (plain puts)",
+            file=sys.stderr,
+        )
 
 
 if __name__ == "__main__":

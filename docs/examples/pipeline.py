@@ -19,18 +19,18 @@ import sys
 import tempfile
 from pathlib import Path
 
-from roadgaze.capture import open_source
 from roadgaze.config import load_config
-from roadgaze.pipeline import Pipeline, create_detector
+from roadgaze.pipeline import RunOptions, build_run
 from roadgaze.synth import render_clip
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.types import Alert, Frame, FrameRecord, Sink
 
 DRIVE = "0:2,0/-35:4,0:3"
 """2 s on the road, 4 s into the lap (yaw 0, pitch -35 deg), 3 s back on the road."""
 
 
-class AlertPrinter:
-    """A sink: `on_record` gets every frame's record in order, `close` once at the end."""
+class AlertPrinter(Sink):
+    """A sink: `on_record` gets every frame's record in order, `on_alert` an alert raised outside
+    the frame loop (a camera gone, a model that cannot be loaded), `close` once at the end."""
 
     def __init__(self) -> None:
         self.frames = 0
@@ -52,6 +52,10 @@ class AlertPrinter:
                 flush=True,
             )
 
+    def on_alert(self, alert: Alert) -> None:
+        self.alerts.append(alert.label)
+        print(f"t={alert.t_s:5.2f} s  ALERT {alert.kind.value}: {alert.reason}", flush=True)
+
     def close(self) -> None:
         pass
 
@@ -60,13 +64,9 @@ def run(video: Path) -> AlertPrinter:
     """Every frame of `video` through the pipeline; returns the sink with what it saw."""
     config = load_config()  # defaults < ROADGAZE__SECTION__FIELD environment variables
     printer = AlertPrinter()
-    with open_source(str(video), config) as source:
-        detector = create_detector(config)
-        try:
-            pipeline = Pipeline.from_config(config, detector)
-            summary = pipeline.run(source, [printer])
-        finally:
-            detector.close()
+    # The run as `roadgaze replay` builds it: the video, the detector, the monitor, our sink.
+    with build_run(config, RunOptions(str(video), command="example"), sinks=(printer,)) as run:
+        summary = run.run()
     print(
         f"{summary.frames} frames, a face in {summary.frames_with_face}, "
         f"in {summary.wall_s:.1f} s; lowest smoothed pitch {printer.min_pitch_deg:.1f} deg; "

@@ -2,7 +2,7 @@
 
 One run, no camera and no video needed: the astronaut photo (or `photo`) is turned through a short
 drive (road, one long look into the lap, a few short glances, road again) by `roadgaze.synth`;
-the service (`roadgaze.pipeline` + `roadgaze.daemon.bus_outputs`: landmarks, full-range yaw,
+the service (`roadgaze.pipeline.build_run`, as `run` builds it: landmarks, full-range yaw,
 pitch, smoother, monitor with zones, Zenoh publisher on 127.0.0.1) runs over the clip as fast as
 it can; a second Zenoh session,
 connected to the first over loopback, subscribes to the alert key and reports each alert as it
@@ -184,10 +184,8 @@ def run_demo(
     Raises RoadgazeError (ModelError, SourceError, TransportError ...) with a clear message; what
     was written before an error stays in `out_dir`.
     """
-    from roadgaze.capture import open_source
-    from roadgaze.daemon import bus_outputs
-    from roadgaze.outputs import AnnotatedVideoWriter, JsonlWriter, YawPlot, fill_offline_columns
-    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.outputs import YawPlot, fill_offline_columns
+    from roadgaze.pipeline import RunOptions, build_run
     from roadgaze.synth import FaceRenderer, load_photo, render_clip
 
     started = time.perf_counter()
@@ -220,28 +218,27 @@ def run_demo(
         monitor=config.monitor,
     )
     progress(f"running the service over {VIDEO_NAME}, Zenoh on tcp/127.0.0.1:{port}")
+    options = RunOptions(
+        str(video_path),
+        command="demo",
+        publish=True,
+        records=out_dir / FRAMES_NAME,
+        annotate=out_dir / ANNOTATED_NAME,
+    )
     with ExitStack() as stack:
         stack.enter_context(plot)
-        source = stack.enter_context(open_source(str(video_path), config))
-        detector = create_detector(config)
-        stack.callback(detector.close)
         # The subscriber closes after the service's session: a subscriber leaving first is a
         # link going down to the service, which warns that alerts are held.
         subscribers = stack.enter_context(ExitStack())
-        bus = stack.enter_context(bus_outputs(config, str(video_path), publish=True))
+        service = stack.enter_context(build_run(config, options, sinks=(plot,)))
         subscriber = AlertSubscriber(
             subscriber_config(config, port), out_dir / ALERTS_NAME, on_alert
         )
         subscribers.callback(subscriber.close)
         if not subscriber.wait_for_publisher(SUBSCRIBER_WAIT_S):
             log.warning("the subscriber did not see the publisher within %.0f s", SUBSCRIBER_WAIT_S)
-        frames_writer = stack.enter_context(JsonlWriter(out_dir / FRAMES_NAME))
-        annotated = stack.enter_context(
-            AnnotatedVideoWriter(out_dir / ANNOTATED_NAME, fps, monitor=config.monitor)
-        )
-        pipeline = Pipeline.from_config(config, detector, speed=bus.speed)
-        summary = pipeline.run(source, [*bus.sinks, plot, frames_writer, annotated])
-        raised = bus.health.alerts_raised
+        summary = service.run()
+        raised = service.health.alerts_raised
         if not subscriber.wait_for_count(raised, SUBSCRIBER_WAIT_S):
             log.warning("the subscriber received %d of %d alerts", len(subscriber.received), raised)
         received = tuple(subscriber.received)

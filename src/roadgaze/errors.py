@@ -24,6 +24,11 @@ class SourceError(RoadgazeError):
     """A video file, image folder or camera cannot be opened or read."""
 
 
+class SpeedError(SourceError):
+    """A vehicle speed that is not one: a speed track that cannot be read or holds a bad value,
+    or a constant speed outside 0-400 km/h (`roadgaze.speed`)."""
+
+
 class DatasetError(RoadgazeError):
     """An evaluation data set is missing or malformed."""
 

@@ -28,6 +28,10 @@ from roadgaze.eye_records import EyeMeasurement as EyeMeasurement
 from roadgaze.eye_records import EyesFeatures as EyesFeatures
 from roadgaze.eye_records import EyeStatus as EyeStatus
 from roadgaze.eye_records import EyesVerdict as EyesVerdict
+from roadgaze.hand_records import Hand as Hand
+from roadgaze.hand_records import HandSide as HandSide
+from roadgaze.hand_records import PhoneJudgement as PhoneJudgement
+from roadgaze.hand_records import PhonePose as PhonePose
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -139,57 +143,6 @@ class FrameCheck:
     first."""
 
 
-class HandSide(StrEnum):
-    """Which of the driver's own hands (not the image side)."""
-
-    LEFT = "left"
-    RIGHT = "right"
-
-
-@dataclass(frozen=True, slots=True)
-class Hand:
-    """One hand the hand stage found (`roadgaze.landmarks.hands`)."""
-
-    side: HandSide
-    """The person's own left or right hand, from MediaPipe's handedness model read for an
-    unmirrored camera."""
-    side_score: float
-    """0..1: how sure the model is of `side` (0.5: no idea)."""
-    score: float
-    """0..1: the landmark model's hand-presence score."""
-    landmarks_px: npt.NDArray[np.float32]
-    """(21, 3) MediaPipe hand landmarks: x, y in image pixels, z (depth, wrist-relative) in the
-    scale of x. 0 wrist, 4 thumb tip, 8 index tip, 12 middle tip, 16 ring tip, 20 pinky tip."""
-    box_px: tuple[float, float, float, float]
-    """Bounding box of the landmarks: x_min, y_min, x_max, y_max."""
-
-
-class PhonePose(StrEnum):
-    """Where a phone is held (`PhoneJudgement.pose`)."""
-
-    EAR = "ear"
-    """At the head: a call."""
-    HELD_UP = "held_up"
-    """In front of the body, above the lap: read or typed on at the wheel or in view."""
-    LAP = "lap"
-    """Low, at the lap or the knee."""
-
-
-@dataclass(frozen=True, slots=True)
-class PhoneJudgement:
-    """The per-frame phone judgement (`roadgaze.phone`): from the hands, the face and the head
-    pose of one frame, no model of its own beyond a small classifier over those."""
-
-    phone_use: bool | None
-    """A phone in hand; None when it cannot be judged (no hand found and no face)."""
-    score: float | None
-    """0..1, `phone_use` is `score >= threshold`; None when it cannot be judged."""
-    hand: HandSide | None = None
-    """The hand that holds it (the one scoring highest); None without a phone."""
-    pose: PhonePose | None = None
-    """Where it is held; None without a phone."""
-
-
 @dataclass(frozen=True, slots=True)
 class PoseSample:
     """What the landmark and pose stages made of one frame: the monitor's input."""
@@ -296,6 +249,20 @@ class Alert:
 
 
 @dataclass(frozen=True, slots=True)
+class Output:
+    """A per-frame output of a monitor behaviour that is not an alert (e.g. a support level for
+    another system): `name` is `value` by the rule `rule` (its key) from `source`, since `since_s`
+    (source timeline; None: not known)."""
+
+    name: str
+    value: str
+    rule: str
+    source: str = ""
+    reason: str = ""
+    since_s: float | None = None
+
+
+@dataclass(frozen=True, slots=True)
 class Verdict:
     """The monitor's view after one frame."""
 
@@ -342,7 +309,10 @@ class Verdict:
     """The rule giving `distraction_warn_s` (e.g. `euroncap.long_distraction`)."""
     camera_neutral_deg: tuple[float, float] | None = None
     """The road-ahead (yaw, pitch) as the camera sees it, for a camera not in front (the monitor's
-    angles are in the driver's frame: roadgaze.pose.mounting); None: the same as the neutral."""
+    angles are in the driver's frame: roadgaze.mounting); None: the same as the neutral."""
+    outputs: tuple[Output, ...] = ()
+    """The monitor behaviours' per-frame outputs that are not alerts (roadgaze.monitor.events
+    `Publish`), in the order the behaviours ran; none today."""
 
     @property
     def eyes_on_road(self) -> bool | None:
@@ -397,3 +367,23 @@ class ClosesOnExit:
         traceback: TracebackType | None,
     ) -> None:
         self.close()
+
+
+class Sink(Protocol):
+    """Where a run's results go: every frame record in order (`on_record`), every alert raised
+    outside the frame loop (`on_alert`: a camera gone for good, a model that cannot be loaded,
+    when no frame comes to carry it) and `close()` once at the end.
+
+    Subclass it to inherit the no-op `on_alert` of a sink with nothing to do with such an alert
+    (a progress bar); a sink that keeps, sends or counts alerts implements it. `on_alert` may be
+    called from another thread, never during another call to the same run's sinks
+    (`roadgaze.pipeline.build_run` holds one lock around both).
+    """
+
+    def on_record(self, record: FrameRecord, frame: Frame) -> None: ...
+
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop; by default nothing to do."""
+        del alert
+
+    def close(self) -> None: ...

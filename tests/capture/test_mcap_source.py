@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import base64
 import json
+import logging
 import subprocess
 import sys
 import time
@@ -17,6 +18,7 @@ import numpy as np
 import pytest
 from mcap.writer import Writer
 
+from fakes import ScriptedDetector, numbered_image
 from foxglove_helpers import pipeline_records
 from repo_paths import child_env
 from roadgaze.capture import McapSource, VideoFileSource, is_mcap, open_source
@@ -24,6 +26,7 @@ from roadgaze.capture.mcap_images import decode_raw
 from roadgaze.config import Config, RecordConfig
 from roadgaze.errors import SourceError
 from roadgaze.outputs.foxglove.open import replay_recorder, vehicle_recorder
+from roadgaze.pipeline import Pipeline
 
 RECORDS = pipeline_records()[:40]
 COMPRESSED = "foxglove.CompressedImage"
@@ -66,12 +69,19 @@ def test_a_vehicle_recording_replays_on_the_source_timeline(tmp_path: Path) -> N
     assert times == pytest.approx([record.t_s for record, _ in RECORDS], abs=1e-9)
 
 
-def foreign_mcap(path: Path, channels: dict[str, tuple[str, list[bytes]]]) -> Path:
-    """An MCAP written with the `mcap` package (no roadgaze metadata): JSON image channels,
-    one message per 1/10 s from t = 1000 s, header stamps 5 ms after the log times."""
+def foreign_mcap(
+    path: Path,
+    channels: dict[str, tuple[str, list[bytes]]],
+    metadata: dict[str, str] | None = None,
+) -> Path:
+    """An MCAP written with the `mcap` package (no roadgaze metadata unless `metadata` gives the
+    `roadgaze` record's): JSON image channels, one message per 1/10 s from t = 1000 s, header
+    stamps 5 ms after the log times."""
     with path.open("wb") as handle:
         writer = Writer(handle)
         writer.start()
+        if metadata is not None:
+            writer.add_metadata("roadgaze", metadata)
         for topic, (schema_name, payloads) in channels.items():
             schema_id = writer.register_schema(schema_name, "jsonschema", b"{}")
             channel_id = writer.register_channel(topic, "json", schema_id)
@@ -82,16 +92,16 @@ def foreign_mcap(path: Path, channels: dict[str, tuple[str, list[bytes]]]) -> Pa
     return path
 
 
-def _stamped(index: int, **fields: object) -> bytes:
-    stamp_ns = 1_000_000_000_000 + index * 100_000_000 + 5_000_000
+def _stamped(index: int, ahead_s: int = 0, **fields: object) -> bytes:
+    stamp_ns = 1_000_000_000_000 + index * 100_000_000 + 5_000_000 + ahead_s * 10**9
     stamp = {"sec": stamp_ns // 10**9, "nsec": stamp_ns % 10**9}
     return json.dumps({"timestamp": stamp, "frame_id": "cam", **fields}).encode()
 
 
-def compressed(index: int, image: np.ndarray, fmt: str = "jpeg") -> bytes:
+def compressed(index: int, image: np.ndarray, fmt: str = "jpeg", ahead_s: int = 0) -> bytes:
     ok, data = cv2.imencode(".png" if fmt == "png" else ".jpg", image)
     assert ok
-    return _stamped(index, data=base64.b64encode(data.tobytes()).decode(), format=fmt)
+    return _stamped(index, ahead_s, data=base64.b64encode(data.tobytes()).decode(), format=fmt)
 
 
 def raw(index: int, image: np.ndarray, encoding: str) -> bytes:
@@ -231,3 +241,87 @@ def test_without_the_mcap_reader_an_mcap_drive_is_one_line(tmp_path: Path) -> No
         "reader, which is not installed: pip install 'roadgaze[foxglove]'"
     )
     assert "Traceback" not in result.stderr
+
+
+def test_a_frame_stamped_far_ahead_is_joined_and_raises_no_alert(tmp_path: Path) -> None:
+    """One frame stamped 10^12 s ahead (a clock stepped on the vehicle, a hostile file), in the
+    middle of a 1.5 s glance away: before, the glance lasted 10^12 s (long_distraction
+    critical, vats, unresponsive). Now the clock is joined across it: the drive's own times,
+    said once, and no alert from the real loop."""
+    count, jump_at = 30, 15
+    messages = [
+        compressed(i, numbered_image(i), "png", ahead_s=10**12 if i == jump_at else 0)
+        for i in range(count)
+    ]
+    path = foreign_mcap(tmp_path / "jump.mcap", {"/camera/image": (COMPRESSED, messages)})
+    with McapSource(path) as source:
+        times = [frame.t_s for frame in source]
+        status = source.status
+    assert times == pytest.approx([0.1 * i for i in range(count)], abs=1e-6)
+    assert "its clock was joined across 2 breaks (the first: timestamps jump" in str(status.message)
+    yaws: list[float | None] = [0.0] * 10 + [-60.0] * 15 + [0.0] * 5  # 1.5 s away
+    pipeline = Pipeline.from_config(Config(), ScriptedDetector(yaws))
+    with McapSource(path) as source:
+        alerts = [alert.kind for done in pipeline.frames(source) for alert in done.record.alerts]
+    assert alerts == []
+
+
+@pytest.mark.parametrize(
+    ("offset", "says"),
+    [
+        ("1" + "0" * 29, "lies outside MCAP's times"),
+        ("-5", "lies outside MCAP's times"),
+        ("1e9", "'1e9' is not an integer"),
+        (str(2_000 * 10**9), "lies after its first frame's stamp"),
+    ],
+    ids=["1e29", "negative", "not-an-integer", "after-the-first-frame"],
+)
+def test_a_time_offset_that_is_no_time_is_said_and_ignored(
+    tmp_path: Path, offset: str, says: str, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A `time_offset_ns` of 1e29 ended in a traceback. The offset only places a drive on its
+    source's timeline; the frames' own stamps still time it, so a bad one is ignored with one
+    warning and the drive starts at its first frame, like a recording roadgaze did not write."""
+    caplog.set_level(logging.WARNING)
+    messages = [compressed(i, numbered_image(i), "png") for i in range(3)]
+    path = foreign_mcap(
+        tmp_path / "offset.mcap",
+        {"/camera/image": (COMPRESSED, messages)},
+        metadata={"time_offset_ns": offset},
+    )
+    with McapSource(path) as source:
+        times = [frame.t_s for frame in source]
+    assert times == pytest.approx([0.0, 0.1, 0.2], abs=1e-9)
+    warnings = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert len(warnings) == 1 and "time_offset_ns" in warnings[0] and says in warnings[0]
+    good = foreign_mcap(
+        tmp_path / "good.mcap",
+        {"/camera/image": (COMPRESSED, messages)},
+        metadata={"time_offset_ns": str(999 * 10**9)},
+    )
+    with McapSource(good) as source:
+        assert [frame.t_s for frame in source] == pytest.approx([1.005, 1.105, 1.205], abs=1e-9)
+
+
+def test_a_raw_frame_of_the_wrong_size_is_skipped_and_counted(tmp_path: Path) -> None:
+    """A RawImage whose bytes do not fill its width x height ended the replay; it is a bad
+    frame like a JPEG that does not decode: skipped, logged, counted, said at the end."""
+    image = RECORDS[0][1].image
+    short = raw(1, image, "bgr8")
+    message = json.loads(short)
+    message["data"] = base64.b64encode(image.tobytes()[:1000]).decode()
+    frames_in = [raw(0, image, "bgr8"), json.dumps(message).encode(), raw(2, image, "bgr8")]
+    path = foreign_mcap(tmp_path / "raw.mcap", {"/raw": ("foxglove.RawImage", frames_in)})
+    with McapSource(path) as source:
+        frames = list(source)
+        status = source.status
+    assert [round(frame.t_s, 6) for frame in frames] == [0.0, 0.2]
+    assert status.frames_skipped == 1
+    assert "1 camera frame skipped (the first: RawImage of 160x120 bgr8 holds 1000 bytes)" in str(
+        status.message
+    )
+    only_bad = foreign_mcap(
+        tmp_path / "bad.mcap", {"/raw": ("foxglove.RawImage", [json.dumps(message).encode()])}
+    )
+    with pytest.raises(SourceError, match=r"no readable camera frame .*1 skipped: RawImage of"):
+        McapSource(only_bad)

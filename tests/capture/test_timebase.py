@@ -20,9 +20,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fakes import numbered_image
-from roadgaze.capture import VideoFileSource
-from roadgaze.capture.timebase import JUMP_MIN_S, JUMP_PERIODS, TimeBase, sane_fps
+from fakes import FakeCamera, numbered_image
+from roadgaze.capture import CameraSource, ImageFolderSource, VideoFileSource
+from roadgaze.capture.timebase import (
+    JUMP_MIN_S,
+    JUMP_PERIODS,
+    TimeBase,
+    sane_fps,
+)
+from roadgaze.config import CaptureConfig
 from roadgaze.errors import SourceError
 
 
@@ -249,3 +255,113 @@ def test_an_avi_whose_header_gives_a_rate_of_zero_is_refused_not_read_at_25_fps(
     assert cv2.VideoCapture(str(path), cv2.CAP_FFMPEG).get(cv2.CAP_PROP_FPS) == 25.0
     with pytest.raises(SourceError, match=r"rate0\.avi: its AVI header gives no frame rate"):
         VideoFileSource(path)
+
+
+def joined_times(fps: float | None, stamps: list[float | None]) -> tuple[list[float], Any]:
+    from roadgaze.capture.timebase import JoinedTimeBase
+
+    base = JoinedTimeBase("drive.mcap", fps)
+    return [base.t_s(index, t_s) for index, t_s in enumerate(stamps)], base
+
+
+@pytest.mark.parametrize(
+    ("stamps", "joined", "breaks", "says"),
+    [
+        # One frame stamped 10^12 s ahead (a hostile file): that frame and the one after it
+        # come back onto the drive's own spacing.
+        ([0.0, 0.2, 0.4, 1e12, 0.8, 1.0], [0.0, 0.2, 0.4, 0.6, 0.8, 1.0], 2, "jump 999999999999.6"),
+        # The vehicle's clock stepped an hour ahead mid-drive (NTP): joined once, spacing kept.
+        ([10.0, 10.2, 10.4, 3610.6, 3610.8], [10.0, 10.2, 10.4, 10.6, 10.8], 1, "jump 3600.200 s"),
+        # ... and back.
+        (
+            [10.0, 10.2, 10.4, 5.0, 5.2],
+            [10.0, 10.2, 10.4, 10.6, 10.8],
+            1,
+            "go backwards at frame 3",
+        ),
+        ([0.0, 0.2, 0.2, 0.6], [0.0, 0.2, 0.4, 0.8], 1, "stall at frame 2"),
+        ([0.0, 0.2, None, 0.6], [0.0, 0.2, 0.4, 0.6], 1, "frame 2 has no valid timestamp"),
+        ([0.0, 0.2, math.inf, 0.6], [0.0, 0.2, 0.4, 0.6], 1, "frame 2 has no valid timestamp"),
+    ],
+    ids=["hostile-frame", "clock-step-ahead", "clock-step-back", "stall", "missing", "infinite"],
+)
+def test_a_recordings_clock_is_joined_across_a_break_with_one_warning(
+    stamps: list[float | None],
+    joined: list[float],
+    breaks: int,
+    says: str,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    caplog.set_level(logging.WARNING)
+    times, base = joined_times(5.0, stamps)
+    np.testing.assert_allclose(times, joined, atol=1e-6)
+    assert base.breaks == breaks and says in (base.first_break or "")
+    assert len(caplog.records) == 1 and "the clock goes on from there" in caplog.text
+
+
+@pytest.mark.parametrize("fps", [None, 0.0, math.nan, 1e9, 0.5])
+def test_a_sparse_recording_keeps_its_times_and_a_gap_in_its_frames_is_joined(
+    fps: float | None,
+) -> None:
+    """Frames 2 s apart (a recording at 0.5 fps) are the drive's own times, whatever the
+    summary's rate says; 3 s without a frame in frames 0.2 s apart (frames lost while
+    recording) is unseen time, joined like any jump: never judged by the monitor."""
+    sparse = [100.0 + 2.0 * index for index in range(8)]
+    assert joined_times(fps, sparse)[0] == sparse
+    gapped = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 4.0, 4.2]
+    times, base = joined_times(fps, gapped)
+    np.testing.assert_allclose(times, [0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4], atol=1e-9)
+    assert base.breaks == 1 and "jump 3.000 s at frame 6" in (base.first_break or "")
+
+
+@settings(max_examples=300, deadline=None)
+@given(clocks())
+def test_fuzzed_recording_clocks_are_increasing_and_never_jump(
+    clock: tuple[float | None, list[float | None]],
+) -> None:
+    """Whatever the stamps: times are finite, strictly increasing, and no jump gets through
+    (nothing for the monitor's timers to run across)."""
+    fps, stamps = clock
+    times = joined_times(fps, stamps)[0]
+    assert all(math.isfinite(t) and t >= 0 for t in times)
+    assert all(b > a for a, b in itertools.pairwise(times))
+    longest_step_s = 5.0  # of the ordinary steps the clocks draw; 10^9, inf, NaN never pass
+    assert all(b - a <= longest_step_s + 1e-3 for a, b in itertools.pairwise(times))
+
+
+@pytest.mark.parametrize("fps", [0.0, -30.0, 0.001, 1e9, math.nan, math.inf])
+def test_an_image_folder_needs_a_rate_that_can_time_it(tmp_path: Path, fps: float) -> None:
+    """A folder's images are timed index / capture.fps: 0.001 fps would put 1000 s between two
+    images and the monitor's timers would run across them."""
+    cv2.imwrite(str(tmp_path / "a.png"), numbered_image(1))
+    with pytest.raises(SourceError, match=r"capture.fps .* cannot time its images") as caught:
+        ImageFolderSource(tmp_path, fps=fps)
+    assert "\n" not in str(caught.value)
+
+
+def test_a_camera_read_that_hangs_is_said_and_its_time_kept() -> None:
+    """The camera's clock is the machine's monotonic clock: a read that hangs 5 s gives a real
+    5 s gap (kept, so recordings stay on the wall clock), said in a warning and the status."""
+    now = [100.0]
+    reads = [0]
+
+    class HangingCamera(FakeCamera):
+        def read(self) -> tuple[bool, Any]:
+            reads[0] += 1
+            if reads[0] <= 12:
+                now[0] += 5.0 if reads[0] == 6 else 1 / 30
+            return super().read()
+
+    source = CameraSource(
+        0, CaptureConfig(fps=30), capture_factory=lambda d: HangingCamera(12), clock=lambda: now[0]
+    )
+    with source:
+        frames = []
+        for frame in source:
+            frames.append(frame)
+            if frame.index >= 8:
+                break
+        status = source.status
+    steps = [b.t_s - a.t_s for a, b in itertools.pairwise(frames)]
+    assert any(step >= 5.0 for step in steps)  # kept, not joined
+    assert "delivered no frame for 5.0 s (a read that hung)" in (status.message or "")

@@ -3,12 +3,17 @@ written. `replay` runs in this process with a scripted source and detector (no M
 
 from __future__ import annotations
 
+import errno
 import hashlib
+import io
+import os
 from pathlib import Path
+from typing import IO
 
 import pytest
 
 import roadgaze.capture
+import roadgaze.outputs.records
 import roadgaze.pipeline
 from fakes import ListSource, ScriptedDetector
 from roadgaze.cli import main
@@ -38,7 +43,33 @@ def one_error_line(capsys: pytest.CaptureFixture[str]) -> str:
     return errors[0]
 
 
+class FullDisk(io.StringIO):
+    """A text stream on a disk that is full: every write fails as a full disk's does."""
+
+    def write(self, text: str) -> int:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
 def test_replay_to_a_full_disk_is_one_line_and_keeps_the_other_outputs(
+    scripted: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    records, table = tmp_path / "frames.jsonl", tmp_path / "frames.csv"
+    real_open = roadgaze.outputs.records.open_for_writing
+
+    def open_on_a_full_disk(path: Path, what: str, newline: str | None = None) -> IO[str]:
+        return FullDisk() if path == table else real_open(path, what, newline)
+
+    monkeypatch.setattr(roadgaze.outputs.records, "open_for_writing", open_on_a_full_disk)
+    code = main(["replay", str(scripted), "--out", str(records), "--csv", str(table),
+                 "--no-progress"])  # fmt: skip
+    assert code == 2
+    assert one_error_line(capsys).endswith(f"No space left on device: {table}")
+    lines = records.read_text().splitlines()
+    assert len(lines) >= 1 and '"frame": 0' in lines[0]  # what was written so far is kept
+
+
+def test_replay_to_a_device_is_refused_before_the_run(
     scripted: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     if not Path("/dev/full").exists():
@@ -47,9 +78,8 @@ def test_replay_to_a_full_disk_is_one_line_and_keeps_the_other_outputs(
     code = main(["replay", str(scripted), "--out", str(records), "--csv", "/dev/full",
                  "--no-progress"])  # fmt: skip
     assert code == 2
-    assert one_error_line(capsys).endswith("No space left on device: /dev/full")
-    lines = records.read_text().splitlines()
-    assert len(lines) >= 1 and '"frame": 0' in lines[0]  # what was written so far is kept
+    assert "--csv /dev/full is not a regular file" in one_error_line(capsys)
+    assert not records.exists()  # refused before anything was written
 
 
 @pytest.mark.parametrize(

@@ -241,5 +241,9 @@ def test_bench_record_reports_what_recording_costs(
     )
     assert 0 < records["loop_thread_cpu_ms_per_frame"] < records["writer_thread_cpu_ms_per_frame"]
     assert cost["passes"][1]["images"] == 0 and cost["passes"][2]["images"] > 0
-    assert images["images_per_frame"] == pytest.approx(5.0 / 15.0, abs=0.02)  # 5 of 15 fps
+    # 5 of 15 fps are due; one the encoder could not take in time (a loaded machine) is dropped
+    # and counted, never lost silently.
+    for taken in [p for p in cost["passes"] if p["kind"] == "images"]:
+        due = (taken["images"] + taken["images_dropped"]) / taken["frames"]
+        assert due == pytest.approx(5.0 / 15.0, abs=0.025)
     assert images["image_thread_cpu_ms_per_image"] > 0 and len(cost["load_average_before"]) == 3

@@ -23,6 +23,7 @@ from roadgaze.transport import Health, Keys
 from roadgaze.types import PoseSample
 from zenoh_helpers import (
     LineReader,
+    advanced_publisher,
     client_config,
     endpoint,
     free_port,
@@ -64,15 +65,7 @@ def valid_state(**changes: Any) -> bytes:
 
 def daemon_publisher(session: zenoh.Session) -> Any:
     """An advanced publisher of the vehicle's alerts, as the daemon declares it."""
-    from zenoh.ext import CacheConfig, MissDetectionConfig, declare_advanced_publisher
-
-    return declare_advanced_publisher(
-        session,
-        ALERT_KEY,
-        cache=CacheConfig(max_samples=10),
-        sample_miss_detection=MissDetectionConfig(heartbeat=0.5),  # type: ignore[call-arg]
-        publisher_detection=True,
-    )
+    return advanced_publisher(session, ALERT_KEY)
 
 
 def test_hostile_payloads_are_reported_and_the_valid_alert_printed_once() -> None:

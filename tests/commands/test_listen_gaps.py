@@ -26,6 +26,7 @@ from roadgaze.commands.listen_alerts import AlertBook
 from roadgaze.config import Config, ZenohConfig
 from roadgaze.transport import Health, Keys, ZenohLink
 from roadgaze.transport.session import SessionPlan, unreachable_hint
+from roadgaze.types import AlertKind, AlertLevel
 from zenoh_helpers import LineReader, RouterProcess, endpoint, free_port
 
 VEHICLE = "car-1"
@@ -117,7 +118,6 @@ def test_alerts_pushed_out_of_a_cache_of_one_are_named_missing_by_a_listener() -
 
 
 def test_a_second_publisher_of_the_vehicles_alerts_is_flagged_every_time() -> None:
-    from zenoh.ext import CacheConfig, MissDetectionConfig, declare_advanced_publisher
 
     port = free_port()
     with zh.router(port), zenoh.open(zh.client_config([endpoint(port)])) as intruder:
@@ -129,13 +129,7 @@ def test_a_second_publisher_of_the_vehicles_alerts_is_flagged_every_time() -> No
             try:
                 assert process.stdout is not None
                 assert "ALERT  car-1 #0" in (LineReader(process).until("ALERT", 20.0)[-1])
-                second = declare_advanced_publisher(
-                    intruder,
-                    f"vehicle/{VEHICLE}/dms/alert",
-                    cache=CacheConfig(max_samples=10),
-                    sample_miss_detection=MissDetectionConfig(heartbeat=0.5),  # type: ignore[call-arg]
-                    publisher_detection=True,
-                )
+                second = zh.advanced_publisher(intruder, f"vehicle/{VEHICLE}/dms/alert")
                 for seq in (100, 101):
                     second.put(alert_message(seq, VEHICLE).to_json_bytes())
                 intruder.put(
@@ -155,6 +149,45 @@ def test_a_second_publisher_of_the_vehicles_alerts_is_flagged_every_time() -> No
     )
     assert "#102" in stderr and "a plain put" in stderr
     assert "totals: 2 alerts printed, 0 missed, 0 messages rejected, 3 foreign" in stderr
+
+
+def test_a_forger_that_speaks_first_never_hides_the_daemons_real_alert() -> None:
+    """Issue 34: a second publisher putting forged `cleared` alerts before the daemon's first
+    alert was taken as the vehicle, and the real `long_distraction` was hidden ("not
+    printed"). Both are printed now, each flagged with its publisher."""
+
+    port = free_port()
+    with zh.router(port), zenoh.open(zh.client_config([endpoint(port)])) as forger_session:
+        link, _ = daemon_link(port)
+        with link:
+            assert zh.wait_for(lambda: link.status().connected, 15.0)
+            process = listen(port, "--timeout", "60")
+            try:
+                reader = LineReader(process)
+                assert reader.until("alive  car-1 joined", 30.0)
+                forger = zh.advanced_publisher(forger_session, f"vehicle/{VEHICLE}/dms/alert")
+                cleared = alert_message(0, VEHICLE).model_copy(
+                    update={"kind": AlertKind.CLEARED, "level": AlertLevel.INFO}
+                )
+                forger.put(cleared.to_json_bytes())
+                forged = reader.until("ALERT", 20.0)[-1]
+                link.publish_alert(alert_message(0, VEHICLE))
+                real = reader.until("ALERT", 20.0)[-1]
+                stderr = stop(process)
+            finally:
+                zh.stop_process(process)
+    assert forged.startswith("ALERT  car-1 #0 cleared info") and "SUSPICIOUS" not in forged
+    assert real.startswith("ALERT  car-1 #0 long_distraction warning")
+    assert "[SUSPICIOUS: publisher 2 of 2 of car-1 (" in real
+    assert "SUSPICIOUS: 2 publishers of car-1's alerts" in stderr
+    assert "SUSPICIOUS alert #0 long_distraction warning of car-1 from a second publisher" in (
+        stderr
+    )
+    assert "): not printed" not in stderr  # nothing hidden
+    assert (
+        "totals: 1 alerts printed, 0 missed, 0 messages rejected, 1 foreign alerts (another "
+        "publisher: 1 of a second publisher, printed flagged; 0 plain puts, not printed)"
+    ) in stderr
 
 
 def test_a_late_listener_prints_joined_first_and_the_final_state_before_left() -> None:

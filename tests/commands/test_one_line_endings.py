@@ -127,9 +127,7 @@ def test_a_second_signal_exits_1_without_a_traceback_at_any_spacing(spacing_s: f
         process.send_signal(signal.SIGINT)
         code = process.wait(timeout=30)
         lines = reader.until("second SIGINT", 10.0)
-        time.sleep(0.2)
-        while (line := reader.next(0.2)) is not None:
-            lines.append(line)
+        lines += reader.rest()
     finally:
         stop_process(process)
     stderr = "\n".join(lines)

@@ -90,3 +90,82 @@ def test_batch_drive_uses_its_manifest_track(drive: Path, tmp_path: Path) -> Non
     assert dict(results["fast"].alert_counts).get("long_distraction", 0) == 1
     # its own 10 km/h track beside the video: nothing
     assert sum(count for _, count in results["beside"].alert_counts) == 0
+
+
+def test_speed_track_and_replay_give_the_monitor_the_same_speed_at_every_frame(
+    tmp_path: Path,
+) -> None:
+    """One track file through both paths, sample for sample:
+
+    - `roadgaze replay drive.mp4`: the track found beside the video (`replay.run_options`, then
+      the builder's `choose_speed`), asked at each frame's time by the loop;
+    - `roadgaze speed --track drive.speed.csv`: what the command publishes (`speed_to_publish`,
+      `publish_track` on a clock), each payload taken by the daemon's speed input
+      (`SpeedInput`, the newest one when the loop asks, once per frame).
+
+    The track is a CAN-like 20 Hz signal with jitter, decimals, a crossing of the 20 km/h active
+    speed, a dropout (empty kmh), a gap longer than the hold and an end; no sample or hold's end
+    falls on a frame time (30 fps), so delivery at 'the same instant' is never decided by float
+    rounding.
+    """
+    from collections import deque
+
+    from fakes import ListSource, ScriptedDetector
+    from roadgaze.cli import build_parser
+    from roadgaze.commands.replay import run_options
+    from roadgaze.commands.speed import speed_to_publish
+    from roadgaze.config import Config
+    from roadgaze.pipeline import Pipeline, choose_speed
+    from roadgaze.transport.speed import SpeedInput, publish_track
+
+    rows = []
+    for k in range(160):  # 0-8 s at 20 Hz
+        t_s = 0.0 if k == 0 else round(0.05 * k + 0.001 + 0.003 * (k % 4), 3)
+        if 3.0 < t_s < 3.5:
+            continue  # no sample for 0.5 s: held
+        if 5.0 < t_s < 7.6:
+            continue  # no sample for 2.6 s: longer than the 2 s hold, unknown
+        kmh = "" if 4.0 < t_s < 4.3 else f"{12.0 + 3.7 * k % 31 + 0.125 * (k % 8):.3f}"
+        rows.append(f"{t_s:.3f},{kmh}\n")
+    video = tmp_path / "drive.mp4"
+    video.write_bytes(b"not read: the frames come from the test")
+    track = tmp_path / "drive.speed.csv"
+    track.write_text("t_s,kmh\n" + "".join(rows), encoding="utf-8")
+    config = Config()
+    parser = build_parser()
+    fps, count = 30.0, 330  # 11 s: past the end of the last sample's hold
+
+    replay_choice = choose_speed(config, run_options(parser.parse_args(["replay", str(video)])))
+    assert replay_choice.track_path == track
+    replayed = Pipeline(ScriptedDetector([0.0] * count), speed=replay_choice.speed)
+    replay_verdicts = [p.record.verdict for p in replayed.frames(ListSource(count, fps))]
+
+    published = speed_to_publish(parser.parse_args(["speed", "--track", str(track)]), config)
+    clock = [0.0]
+
+    def wait(seconds: float) -> bool:
+        clock[0] += seconds
+        return False
+
+    puts: deque[tuple[float, bytes]] = deque()
+    for _ in publish_track(published, lambda p: puts.append((clock[0], p)), wait, lambda: clock[0]):
+        pass
+    now = [0.0]
+    bus = SpeedInput(config.zenoh.speed_timeout_s, clock=lambda: now[0])
+    daemon = Pipeline(ScriptedDetector([0.0] * count), speed=bus.kmh)
+    frames = daemon.frames(ListSource(count, fps))
+    bus_verdicts = []
+    for index in range(count):
+        now[0] = index / fps
+        while puts and puts[0][0] <= now[0]:
+            bus.on_payload(puts.popleft()[1])  # the ring of one keeps the newest
+        bus_verdicts.append(next(frames).record.verdict)
+
+    replay_speeds = [v.speed_kmh for v in replay_verdicts]
+    assert [v.speed_kmh for v in bus_verdicts] == replay_speeds
+    assert [v.moving for v in bus_verdicts] == [v.moving for v in replay_verdicts]
+    known = {speed for speed in replay_speeds if speed is not None}
+    assert len(known) > 20 and min(known) < 20.0 < max(known)  # the gate opens and closes
+    assert None in replay_speeds[125:135]  # the dropout (4.0-4.3 s)
+    assert replay_speeds[100] is not None  # 3.33 s: held through the 0.5 s without a sample
+    assert replay_speeds[210] is None and replay_speeds[-1] is None  # the long gap (7 s), the end

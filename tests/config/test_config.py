@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from repo_paths import REPO
 from roadgaze.config import Config, load_config, parse_overrides
 from roadgaze.errors import ConfigError
+from roadgaze.monitor.zones import ZoneMap
 
 
 def test_defaults_are_the_documented_ones() -> None:
@@ -110,7 +111,7 @@ def test_zones_come_from_the_configuration_road_first() -> None:
         },
         environ={},
     )
-    zones = config.monitor.zone_map()
+    zones = ZoneMap.from_config(config.monitor)
     assert [zone.name for zone in zones.zones] == ["road", "rear_mirror"]
     road = zones.zones[0]
     assert (road.yaw_min_deg, road.yaw_max_deg) == (-25.0, 25.0)  # left at 30, entered at 25

@@ -1,5 +1,6 @@
 """The scenarios' frames: noise on every frame, a covered lens, frozen frames byte for byte, no
-face, sunglasses, the face as a camera at a mounting preset sees it, the speed track."""
+face, what the driver wears, a talking mouth, the night, a hand on the wheel, the face as a
+camera at a mounting preset sees it, the speed track."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ import pytest
 from roadgaze.capture.speed_track import read_speed_track
 from roadgaze.conformance.clips import RenderedSource, ScenarioRenderer
 from roadgaze.conformance.model import Scenario, Segment
+from roadgaze.errors import ConfigError
 from roadgaze.pose.mounting import head_to_camera, mounting_for
 from roadgaze.synth.eyes import EyeState
 
@@ -55,15 +57,25 @@ def test_a_preset_renders_the_face_as_its_camera_sees_it(renderer: ScenarioRende
     frame = next(renderer.frames(scenario)).astype(np.float64)
     yaw, pitch, _ = head_to_camera(mounting_for("a_pillar"), 0.0, -35.0)
     assert yaw < -20.0  # the camera on the left pillar sees the face turned to its right
-    seen = renderer.renderer.render_eyes(yaw, pitch, EyeState()).astype(np.float64)
-    front = renderer.renderer.render_eyes(0.0, -35.0, EyeState()).astype(np.float64)
+    facing = renderer.facing_pitch_deg
+    seen = renderer.renderer.render_eyes(yaw, pitch + facing, EyeState()).astype(np.float64)
+    front = renderer.renderer.render_eyes(0.0, -35.0 + facing, EyeState()).astype(np.float64)
     assert np.abs(frame - seen).mean() < 3.0 < np.abs(frame - front).mean()
+
+
+def test_the_road_pose_faces_the_camera(renderer: ScenarioRenderer) -> None:
+    """The photo's face looks 11.5 deg below its camera; a scenario looking at the road with the
+    camera in front is rendered facing the lens."""
+    assert renderer.facing_pitch_deg == pytest.approx(11.5, abs=0.5)
+    frame = next(renderer.frames(Scenario("road", "", (Segment(0.2),), 70.0, ())))
+    faced = renderer.renderer.render_eyes(0.0, renderer.facing_pitch_deg, EyeState())
+    assert np.abs(frame.astype(np.float64) - faced.astype(np.float64)).mean() < 3.0
 
 
 def test_sunglasses_cover_the_eyes(renderer: ScenarioRenderer) -> None:
     plain, dark = (
-        next(renderer.frames(Scenario("g", "", (Segment(0.2),), 70.0, (), sunglasses=glasses)))
-        for glasses in (False, True)
+        next(renderer.frames(Scenario("g", "", (Segment(0.2),), 70.0, (), conditions=worn)))
+        for worn in ((), ("dark_sunglasses",))
     )
     changed = np.abs(grey(plain) - grey(dark)) > 40
     assert 0.005 < changed.mean() < 0.08  # two lenses: a small part of the frame
@@ -99,3 +111,74 @@ def test_eyes_at_rest_turn_with_the_head_as_an_eyeball(renderer: ScenarioRendere
         assert np.array_equal(eyes.render_eyes(0.0, 20.0, EyeState()), eyes.render(0.0, 20.0))
     finally:
         eyes.eyeball_at_rest = True
+
+
+def test_conditions_render_from_the_first_frame(renderer: ScenarioRenderer) -> None:
+    def first(*conditions: str, mounting: str = "front") -> Any:
+        scenario = Scenario("c", "", (Segment(0.2),), 70.0, (), mounting, conditions)
+        return grey(next(renderer.frames(scenario)))
+
+    plain = first()
+    assert Scenario("s", "", (), None, (), conditions=("dark_sunglasses",)).sunglasses
+    for name in ("clear_sunglasses", "stubble", "beard", "mask", "cap", "hat", "fringe"):
+        assert np.abs(first(name) - plain).mean() > 0.5, name
+    night = next(
+        renderer.frames(Scenario("c", "", (Segment(0.2),), 70.0, (), conditions=("night",)))
+    )
+    assert np.array_equal(night[..., 0], night[..., 2]) and night.std() < 0.7 * plain.std()
+    column, front = first("hand_at_12", mounting="steering_column"), first("hand_at_12")
+    (x0, y0), (x1, y1) = renderer.renderer.mesh.points_px[[33, 263], :2].round().astype(int)
+    eyes = (slice(min(y0, y1) - 3, max(y0, y1) + 4), slice(x0, x1))  # where the eyes rest
+    assert np.abs(column - first(mounting="steering_column"))[eyes].mean() > 10.0
+    assert np.abs(front - plain)[eyes].mean() < 2.0
+    with pytest.raises(ConfigError, match="unknown condition sunhat"):
+        first("sunhat")
+
+
+def test_a_talking_driver_moves_the_mouth_and_nothing_else(renderer: ScenarioRenderer) -> None:
+    scenario = Scenario("talk", "", (Segment(4.0),), 70.0, (), conditions=("talking",))
+    frames = [grey(f) for f in renderer.frames(scenario)]
+    still = [grey(f) for f in renderer.frames(replace_conditions(scenario, ()))]
+    mouth = (slice(92, 112), slice(65, 95))  # the lips and chin in a 160 px frame
+    moved = [np.abs(a - b)[mouth].mean() for a, b in zip(frames, still, strict=True)]
+    assert max(moved) > 5.0 and min(moved) < 2.0  # it opens and closes
+    eyes = (slice(45, 65), slice(50, 110))
+    assert max(np.abs(a - b)[eyes].mean() for a, b in zip(frames, still, strict=True)) < 2.0
+
+
+def replace_conditions(scenario: Scenario, conditions: tuple[str, ...]) -> Scenario:
+    from dataclasses import replace
+
+    return replace(scenario, conditions=conditions)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("scenario_name", "condition"),
+    [
+        ("microsleep_70", "night"),
+        ("microsleep_70", "clear_sunglasses"),
+        ("side_left_70", "stubble"),
+        ("microsleep_70", "talking"),
+    ],
+)
+def test_a_green_scenario_still_passes_under_a_noise_variable(
+    tmp_path: Path, scenario_name: str, condition: str
+) -> None:
+    """The real service (MediaPipe, the pipeline, the monitor) on the drive rendered under the
+    condition, as the dossier runs it: every requirement still PASS."""
+    from roadgaze.config import Config
+    from roadgaze.conformance.dossier_rows import under
+    from roadgaze.conformance.matrix import scenario_matrix
+    from roadgaze.conformance.run import run_suite
+    from roadgaze.synth import EyeRenderer, load_photo
+
+    config = Config()
+    monitor = config.monitor.model_dump() | {"protocol": "euroncap"}
+    config = config.model_copy(update={"monitor": type(config.monitor).model_validate(monitor)})
+    scenario = next(s for s in scenario_matrix(config.monitor) if s.name == scenario_name)
+    eyes = EyeRenderer(load_photo(), (320, 320), config=config, eyeball_at_rest=True)
+    suite = run_suite([under(condition)(scenario)], config, tmp_path, ScenarioRenderer(eyes, 15.0))
+    assert suite.outcomes and all(o.result == "PASS" for o in suite.outcomes), [
+        (o.requirement.key, o.measured_s, o.alerts) for o in suite.outcomes
+    ]

@@ -6,7 +6,14 @@ from __future__ import annotations
 
 import pytest
 
-from dossier_fakes import FakeRunner, euroncap_scenarios, outcomes_of
+from dossier_fakes import (
+    MANDATORY,
+    NOTICES,
+    FakeRunner,
+    euroncap_scenarios,
+    failing_under,
+    outcomes_of,
+)
 from roadgaze.conformance.dossier import (
     GREEN,
     RED,
@@ -64,15 +71,17 @@ def test_a_right_hand_drive_cabin_swaps_the_driver_and_passenger_sides() -> None
 
 
 def test_noise_variables_are_functional_only_when_every_green_cell_passes_under_them() -> None:
-    runner = FakeRunner()
+    runner = FakeRunner(failing=failing_under("night"))
     dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
     sunglasses = dossier.noise_of("Dark sunglasses")
     assert sunglasses is not None and sunglasses.performance == "Functional"
-    assert all(name.endswith("__dark_sunglasses") for name in runner.calls)
     green = {key.split(".")[0] for c in dossier.cells if c.colour == GREEN for key in c.keys}
-    assert {name.removesuffix("__dark_sunglasses") for name in runner.calls} == green
-    unrendered = [n for n in dossier.noise if n.variable.variant is None]
-    assert unrendered and all(n.performance == "Non Functional" for n in unrendered)
+    ran = [name for name in runner.calls if name.endswith("__dark_sunglasses")]
+    assert {name.removesuffix("__dark_sunglasses") for name in ran} == green
+    night = dossier.noise_of("Daytime - Night-time")
+    assert night is not None and night.performance == "Non Functional"
+    assert [name for name in runner.calls if name.endswith("__night")] == ["microsleep_70__night"]
+    assert all(n.variable.variant is not None for n in dossier.noise)
 
 
 def test_a_noise_variable_stops_at_the_first_scenario_failing_under_it() -> None:
@@ -81,12 +90,13 @@ def test_a_noise_variable_stops_at_the_first_scenario_failing_under_it() -> None
     sunglasses = dossier.noise_of("Dark sunglasses")
     assert sunglasses is not None and not sunglasses.functional
     assert sunglasses.why.startswith("microsleep_70__dark_sunglasses: FAIL: microsleep_70.warns")
-    assert runner.calls == ["microsleep_70__dark_sunglasses"]  # the shortest drive goes first
+    ran = [name for name in runner.calls if name.endswith("__dark_sunglasses")]
+    assert ran == ["microsleep_70__dark_sunglasses"]  # the shortest drive goes first
 
 
 def test_general_requirements_answer_pass_fail_or_na_with_their_basis() -> None:
     outcomes = outcomes_of(SCENARIOS, failed=("lap_70.warns",))
-    dossier = judge(outcomes, SCENARIOS, FakeRunner(), "lhd")
+    dossier = judge(outcomes, SCENARIOS, FakeRunner(failing=failing_under("cap")), "lhd")
     answers = {g.requirement.text: g for g in dossier.general}
     assert answers["Default ON at the start of every journey"].value == "FAIL"
     assert answers["Continuous monitoring of the driver state"].value == "PASS"
@@ -95,11 +105,12 @@ def test_general_requirements_answer_pass_fail_or_na_with_their_basis() -> None:
     sunglasses = next(g for text, g in answers.items() if text.endswith("dark sunglasses"))
     assert sunglasses.value == "N/A"  # dark sunglasses shown functional: nothing to inform of
     cap = next(g for text, g in answers.items() if text.endswith("wears a cap"))
-    assert cap.value == "FAIL"
+    assert cap.value == "FAIL"  # the cap not shown functional: a notice is due
 
 
 def test_the_gates_name_what_holds_the_score_and_can_be_taken_as_met() -> None:
-    dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, FakeRunner(), "lhd")
+    runner = FakeRunner(failing=failing_under(*MANDATORY, *NOTICES))
+    dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
     gates = dossier.gates()
     assert gates[0] == (
         "mandatory noise variables not shown functional: Daytime - Night-time, Clear "

@@ -59,8 +59,9 @@ def test_a_run_writes_the_dossier_and_prints_the_official_score(
     assert code == 0
     ws = openpyxl.load_workbook(dossier)["DE - DM pred."]
     assert [ws[c].value for c in ("D70", "E70", "D71", "F72")] == ["Green", "Red", "Red", "Red"]
-    # Measured: behind dark lenses the eyes are not judged, so the microsleep goes unwarned.
-    assert ws["D4"].value == "Non Functional" and ws["D2"].value == "Non Functional"
+    # Measured: behind dark lenses the eyes are not judged, so the microsleep goes unwarned;
+    # at night (the infrared picture) it is warned as by day.
+    assert ws["D4"].value == "Non Functional" and ws["D2"].value == "Functional"
     assert "| 71 | Sleep | RED (not run: sleep_70.warns) |" in out
     assert "\nDriver Monitoring: 0 / 25 points\n" in out
     assert "the rows alone, were those met: 0.5 / 25 (Non-transient - Microsleep 0.5)" in out

@@ -15,6 +15,8 @@ from roadgaze.conformance.dossier_rows import (
     key_for,
     row_at,
 )
+from roadgaze.conformance.model import Scenario, Segment
+from roadgaze.synth.outfit import CONDITIONS
 
 
 @pytest.mark.parametrize("cabin", ["lhd", "rhd"])
@@ -56,3 +58,18 @@ def test_the_wording_and_the_mandatory_noise_variables_are_the_calculators() -> 
     )
     mandatory = [v.element for v in NOISE_VARIABLES if v.mandatory]
     assert mandatory == driver_monitoring.MANDATORY_FUNCTIONAL_ELEMENTS
+
+
+def test_every_noise_variable_is_rendered_under_its_condition() -> None:
+    """Each noise variable carries a variant rendering a scenario under one condition the
+    renderer knows, named after it; the scenario is otherwise the same."""
+    scenario = Scenario("lap_70", "a look", (Segment(1.0),), 70.0, (), conditions=("talking",))
+    names = []
+    for variable in NOISE_VARIABLES:
+        assert variable.variant is not None, variable.element
+        shown = variable.variant(scenario)
+        condition = variable.variant.__name__
+        assert condition in CONDITIONS and shown.conditions == ("talking", condition)
+        assert shown.name == f"lap_70__{condition}" and shown.segments == scenario.segments
+        names.append(condition)
+    assert len(set(names)) == len(NOISE_VARIABLES) == 12

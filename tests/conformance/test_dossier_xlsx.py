@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from dossier_fakes import FakeRunner, euroncap_scenarios, outcomes_of
+from dossier_fakes import FakeRunner, euroncap_scenarios, failing_under, outcomes_of
 from roadgaze.conformance.dossier import judge
 from roadgaze.conformance.dossier_xlsx import check_template, write_dossier
 from roadgaze.errors import ConfigError
@@ -77,7 +77,7 @@ def test_a_template_not_as_expected_is_one_line_naming_what_was_found(
 
 def test_the_filled_sheet_holds_the_dossiers_values(tmp_path: Path) -> None:
     scenarios = euroncap_scenarios()
-    runner = FakeRunner(failing={"microsleep_70__dark_sunglasses"})
+    runner = FakeRunner(failing=failing_under("dark_sunglasses", "night"))
     dossier = judge(outcomes_of(scenarios, failed=("sleep_70.warns",)), scenarios, runner, "lhd")
     out = write_dossier(template(), dossier, tmp_path / "d.xlsx")
     ws = openpyxl.load_workbook(out)[SHEET]
@@ -90,6 +90,7 @@ def test_the_filled_sheet_holds_the_dossiers_values(tmp_path: Path) -> None:
         None,
     ]
     assert ws["D2"].value == "Non Functional" and ws["D4"].value == "Non Functional"
+    assert ws["D3"].value == "Functional"  # clear sunglasses: every GREEN cell passed under them
     greens = sum(c.value == "Green" for row in ws["D17:F72"] for c in row)
     assert greens == sum(c.colour == "Green" for c in dossier.cells) == 6
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d.xlsx"]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-import roadgaze.doctor.service as service
+import roadgaze.doctor.resources as service
 import roadgaze.doctor.software as software
 from roadgaze.cli import main
 from roadgaze.config import Config, load_config

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import zlib
+
 import numpy as np
 import pytest
 
@@ -9,15 +11,18 @@ from roadgaze.evaluation.conditions import (
     CLEAN,
     CONDITIONS,
     NOSE_RIDGE,
+    SEED,
     apply_condition,
     bright_glare,
     condition_names,
+    condition_parameters,
     dark_cabin,
     face_mask,
     ir_grey,
     jpeg_compression,
     low_resolution,
     motion_blur,
+    parse_condition,
     sunglasses,
 )
 from roadgaze.landmarks.eye_landmarks import LEFT_EYE, RIGHT_EYE
@@ -128,3 +133,60 @@ def test_condition_names() -> None:
     assert condition_names(["all"]) == ["clean", *CONDITIONS]
     with pytest.raises(ValueError, match=r"unknown condition 'fog'.*ir_grey"):
         condition_names(["fog"])
+
+
+def test_a_condition_takes_other_values_for_its_parameters(scene: np.ndarray) -> None:
+    """`ir_grey:noise_std=9,contrast=0.3` is `ir_grey` with those keyword values and the same
+    noise seed; the suite's values are the functions' defaults."""
+    assert parse_condition("ir_grey") == ("ir_grey", {})
+    name, parameters = parse_condition("ir_grey:noise_std=9,contrast=0.3")
+    assert (name, parameters) == ("ir_grey", {"noise_std": 9.0, "contrast": 0.3})
+    assert parse_condition("motion_blur:length_px=21") == ("motion_blur", {"length_px": 21})
+    assert condition_parameters("dark") == {"gain": 0.15, "noise_std": 3.0}
+    harder = apply_condition("ir_grey:noise_std=9,contrast=0.3", scene, None, "a.jpg")
+    key = zlib.crc32(b"ir_grey\0a.jpg")
+    expected = ir_grey(scene, np.random.default_rng([SEED, key]), noise_std=9.0, contrast=0.3)
+    np.testing.assert_array_equal(harder, expected)
+    np.testing.assert_array_equal(
+        apply_condition("dark:gain=0.15", scene, None, "a.jpg"),
+        apply_condition("dark", scene, None, "a.jpg"),
+    )
+    assert condition_names(["dark:gain=0.1", "ir_grey", "dark"]) == [
+        "clean",
+        "ir_grey",
+        "dark",
+        "dark:gain=0.1",
+    ]
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("fog:level=3", "unknown condition 'fog'"),
+        ("dark:gamma=2", "parameter among gain, noise_std, found 'gamma=2'"),
+        ("dark:gain", "expected PARAMETER=VALUE"),
+        ("dark:gain=dim", "gain must be a number, found 'dim'"),
+        ("jpeg:quality=7.5", "quality must be a whole number, found '7.5'"),
+    ],
+)
+def test_bad_condition_parameters_are_named(text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        condition_names([text])
+
+
+def test_the_suite_counts_faces_per_subject() -> None:
+    from roadgaze.evaluation.condition_suite import format_subject_table, score_condition
+    from roadgaze.evaluation.ground_truth import GroundTruth
+    from roadgaze.evaluation.images import ImageEstimate
+
+    truths = [GroundTruth(f"{i}.jpg", 0.0, 0.0, subject) for i, subject in enumerate("aabbb")]
+    found = [True, False, True, True, False]
+    estimates = [ImageEstimate(file=t.file, face=f) for t, f in zip(truths, found, strict=True)]
+    row = score_condition("dark", truths, estimates)
+    assert row.faces_by_subject == (("a", 1, 2), ("b", 2, 3))
+    assert row.to_json_dict()["subjects"][1] == {"subject": "b", "faces": 2, "images": 3}
+    assert format_subject_table([row]) == (
+        "| faces found % by subject | a | b |\n|---|---|---|\n| dark | 50.0 | 66.7 |"
+    )
+    anonymous = [GroundTruth(t.file, 0.0) for t in truths]
+    assert format_subject_table([score_condition("dark", anonymous, estimates)]) is None

@@ -5,6 +5,7 @@ where Ray is already initialised (or only on the main thread) fails here."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import signal
@@ -12,7 +13,6 @@ import socket
 import subprocess
 import sys
 import tempfile
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -22,6 +22,7 @@ import pytest
 
 from repo_paths import child_env
 from roadgaze.fleet import output_paths
+from zenoh_helpers import free_port, wait_for
 
 pytest.importorskip("ray", reason="Ray is the optional extra roadgaze[ray]")
 
@@ -80,55 +81,66 @@ def _processes_naming(text: str) -> list[str]:
 
 
 def test_a_fresh_process_with_no_ray_running_starts_one_and_equals_the_local_engine(
-    local_batch: Any, tmp_path: Path
+    local_batch: Any, tmp_path: Path, ray_tmp: Path
 ) -> None:
     """The case that broke in 0.2: `ray.init` on a helper thread started a local instance
     that the kernel killed when the thread ended (parent-death signal of that thread)."""
     out = tmp_path / "ray-out"
-    # Ray's unix sockets live under its temp folder: keep the path short (108 bytes at most).
-    ray_tmp = Path(tempfile.mkdtemp(prefix="rg-ray-", dir="/tmp"))
-    try:
-        done = _batch(local_batch.input.folder, out, ray_tmp=ray_tmp)
-        assert done.returncode == 3, done.stderr[-2000:]  # the corrupt and empty drives fail
-        assert "on ray with" in done.stderr
-        _assert_same_as_local(out, local_batch)
-        time.sleep(2.0)  # Ray's own processes end shortly after the driver's shutdown
-        assert _processes_naming(str(ray_tmp)) == []  # the instance it started is gone
-    finally:
-        shutil.rmtree(ray_tmp, ignore_errors=True)
+    done = _batch(local_batch.input.folder, out, ray_tmp=ray_tmp)
+    assert done.returncode == 3, done.stderr[-2000:]  # the corrupt and empty drives fail
+    assert "on ray with" in done.stderr
+    _assert_same_as_local(out, local_batch)
+    # Ray's own processes end shortly after the driver's shutdown: the instance it started is
+    # gone (waited for up to a bound far beyond their usual second or two).
+    assert wait_for(lambda: _processes_naming(str(ray_tmp)) == [], timeout_s=60.0), (
+        _processes_naming(str(ray_tmp))
+    )
 
 
 @pytest.fixture
-def ray_head(tmp_path: Path) -> Iterator[str]:
+def ray_tmp() -> Iterator[Path]:
+    """A Ray temporary folder of this test's own (never the shared /tmp/ray); short, because
+    Ray's unix sockets live under it (108 bytes at most)."""
+    folder = Path(tempfile.mkdtemp(prefix="rg-ray-", dir="/tmp"))
+    try:
+        yield folder
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture
+def ray_head(tmp_path: Path, ray_tmp: Path) -> Iterator[str]:
     """A real Ray head started with `ray start --head --block` in a process group of its own
-    (stopped by signalling that group, never `ray stop`, which would stop every Ray here)."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
+    (stopped by signalling that group, never `ray stop`, which would stop every Ray here), in a
+    temporary folder of its own and on ports chosen by the OS (not Ray's fixed defaults)."""
+    port, agent_port = free_port(), free_port()
     ray_cli = Path(sys.executable).with_name("ray")
     head = subprocess.Popen(
         [
             *(str(ray_cli), "start", "--head", "--block", f"--port={port}", "--num-cpus=1"),
-            *("--include-dashboard=false", "--disable-usage-stats"),
+            *("--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={ray_tmp}"),
+            f"--dashboard-agent-listen-port={agent_port}",
         ],
         stdout=(tmp_path / "ray-head.log").open("w"),
         stderr=subprocess.STDOUT,
         start_new_session=True,
     )
     try:
-        deadline = time.monotonic() + 180.0
-        while time.monotonic() < deadline:
+
+        def listening() -> bool:
+            assert head.poll() is None, (tmp_path / "ray-head.log").read_text()[-2000:]
             try:
                 with socket.create_connection(("127.0.0.1", port), timeout=1.0):
-                    break
+                    return True
             except OSError:
-                assert head.poll() is None, (tmp_path / "ray-head.log").read_text()[-2000:]
-                time.sleep(0.5)
-        else:
+                return False
+
+        if not wait_for(listening, timeout_s=180.0, every_s=0.2):
             pytest.fail("ray start --head did not listen within 180 s")
         yield f"127.0.0.1:{port}"
     finally:
-        os.killpg(head.pid, signal.SIGTERM)
+        with contextlib.suppress(ProcessLookupError):  # gone already: its log says why
+            os.killpg(head.pid, signal.SIGTERM)
         try:
             head.wait(timeout=30)
         except subprocess.TimeoutExpired:
@@ -137,10 +149,11 @@ def ray_head(tmp_path: Path) -> Iterator[str]:
 
 
 def test_a_running_head_at_an_address_is_used_and_left_running(
-    local_batch: Any, tmp_path: Path, ray_head: str
+    local_batch: Any, tmp_path: Path, ray_head: str, ray_tmp: Path
 ) -> None:
     out = tmp_path / "ray-out"
-    done = _batch(local_batch.input.folder, out, "--ray-address", ray_head, "--ray-timeout", "120")
+    args = ("--ray-address", ray_head, "--ray-timeout", "120")
+    done = _batch(local_batch.input.folder, out, *args, ray_tmp=ray_tmp)
     assert done.returncode == 3, done.stderr[-2000:]
     _assert_same_as_local(out, local_batch)
     host, port = ray_head.split(":")

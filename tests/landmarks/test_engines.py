@@ -332,3 +332,78 @@ def test_faces_completed_when_measured_equal_a_whole_run(model_path: Path) -> No
             yaw_deg, pitch_deg = angles_from_matrix_deg(matrix)
             assert measured[0].mediapipe_yaw_deg == yaw_deg
             assert measured[0].mediapipe_pitch_deg == pitch_deg
+
+
+# ---------------------------------------------------------------- a rejected face looked at again
+
+
+def test_the_mirror_order_pairs_each_landmark_with_its_mirror_image(
+    canonical_face: CanonicalFace,
+) -> None:
+    order = graph.mirror_order(canonical_face.points)
+    assert order.shape == (478,) and np.array_equal(order[order], np.arange(478))
+    pairs = {33: 263, 133: 362, 61: 291, 234: 454, 468: 473, 469: 476, 471: 474, 472: 477}
+    assert all(order[a] == b and order[b] == a for a, b in pairs.items())
+    assert all(order[i] == i for i in (1, 4, 10, 152))  # on the mid-line
+    lopsided = canonical_face.points.copy()
+    lopsided[0, 33] += 0.5
+    with pytest.raises(ValueError, match="not mirror-symmetric"):
+        graph.mirror_order(lopsided)
+    raw = np.random.default_rng(0).uniform(0, 256, (1, 1434)).astype(np.float32)
+    once = graph.unmirror_landmarks(raw, 256, order)
+    assert (
+        once[33, 0] == pytest.approx(256 - raw[0, 263 * 3]) and once[33, 2] == raw[0, 263 * 3 + 2]
+    )
+    twice = graph.unmirror_landmarks(once, 256, order)
+    np.testing.assert_allclose(twice, raw.reshape(-1, 3), atol=1e-4)
+
+
+class _OneSidedModel:
+    """A fake landmark model that sees a face only in a crop brighter on its right half (the
+    test's image is brighter on its left: only the mirrored crop), with every landmark at x 64,
+    y 128, z 0 in the crop but the right eye's outer corner (33) at x 40."""
+
+    def __init__(self) -> None:
+        self.crops: list[np.ndarray[Any, Any]] = []
+
+    def run(self, values: np.ndarray[Any, Any], scale: float = 1.0) -> list[np.ndarray[Any, Any]]:
+        self.crops.append(np.array(values))
+        raw = np.tile(np.float32([64.0, 128.0, 0.0]), (478, 1))
+        raw[33, 0] = 40.0
+        right_brighter = values[:, 128:].mean() > values[:, :128].mean()
+        return [raw.reshape(1, -1), np.float32([[10.0 if right_brighter else -10.0]])]
+
+
+class _OneFace:
+    """A fake detector: one face in the middle of the image."""
+
+    def detect(self, rgb: np.ndarray[Any, Any]) -> list[graph.FaceDetection]:
+        keypoints = np.array(
+            [[0.4, 0.45], [0.6, 0.45], [0.5, 0.55], [0.5, 0.65], [0.3, 0.5], [0.7, 0.5]]
+        )
+        return [graph.FaceDetection((0.3, 0.3, 0.7, 0.7), keypoints, 0.9)]
+
+
+def test_a_rejected_face_is_looked_at_again_recut_and_mirrored(model_path: Path) -> None:
+    from roadgaze.landmarks.engines.litert import Bundle, LiteRtFaceLandmarker, Models
+
+    model = _OneSidedModel()
+    models = Models(_OneFace(), model, model)  # type: ignore[arg-type]
+    runner = LiteRtFaceLandmarker(Bundle.read(model_path), LandmarksConfig(), 1, False, models)
+    rgb = np.zeros((480, 640, 3), np.uint8)
+    rgb[:, :320] = 200  # brighter on the left: the face is seen only mirrored
+    assert runner.track(rgb, None) == [] and len(model.crops) == 1  # MediaPipe's rule
+    model.crops.clear()
+    (points,) = runner.track(rgb, None, retry_rejected=True)
+    assert len(model.crops) == 3  # the detector's region, re-cut, mirrored: found
+    np.testing.assert_array_equal(model.crops[2], model.crops[0][:, ::-1])
+    model.crops.clear()
+    rgb[:] = 100  # even: no look finds the face, the fourth is re-cut from the mirrored one
+    assert runner.track(rgb, None, retry_rejected=True) == [] and len(model.crops) == 4
+    # Put back from the mirrored crop: x 64 -> 192 of 256, the corner 33 is 263's (x 64 -> 192),
+    # and 263 is 33's (x 40 -> 216): the eye corners on their own sides again.
+    order = graph.mirror_order(Bundle.read(model_path).face.points)
+    assert order[33] == 263
+    xs = (points[:, 0] - 0.5) * 640 / (1.5 * 0.4 * 640) * 256 + 128  # back to crop pixels
+    assert xs[33] == pytest.approx(192.0, abs=0.01) and xs[263] == pytest.approx(216.0, abs=0.01)
+    assert np.median(xs) == pytest.approx(192.0, abs=0.01)

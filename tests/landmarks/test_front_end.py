@@ -3,6 +3,8 @@ wrapper's second look, hold and wait in a stream (fake detectors: no MediaPipe).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -153,6 +155,100 @@ def test_an_enhanced_still_without_a_face_is_looked_at_untouched() -> None:
     assert detector.detect(DARK).driver is None
     assert [image.ndim for _, image in inner.seen] == [2, 3]  # enhanced (grey), then as it came
     np.testing.assert_array_equal(inner.seen[1][1], DARK)
+
+
+def noisy(frame: np.ndarray, std: float = 6.0, seed: int = 0) -> np.ndarray:
+    """`frame` with Gaussian sensor noise of `std` levels."""
+    values = frame + np.random.default_rng(seed).normal(0.0, std, frame.shape)
+    return np.clip(np.rint(values), 0, 255).astype(np.uint8)
+
+
+def grain(image: np.ndarray) -> float:
+    """The noise left in a frame whose rows are all alike (ramps, steps): the standard deviation
+    of its levels about their column's mean."""
+    values = image.astype(float)
+    return float((values - values.mean(axis=0)).std())
+
+
+class SteppedDetector:
+    """Fake detector with the loop's steps and the landmarker's `retry_rejected`: a face when
+    `accepts(image)`, recording (t_s, image, retry_rejected) per inference."""
+
+    def __init__(self, accepts: Callable[[np.ndarray], bool]) -> None:
+        self.accepts = accepts
+        self.seen: list[tuple[float | None, np.ndarray, bool]] = []
+
+    def prepare(self, image: np.ndarray) -> np.ndarray:
+        return image
+
+    def infer(
+        self, image: np.ndarray, t_s: float | None = None, *, retry_rejected: bool = False
+    ) -> Detection:
+        self.seen.append((t_s, image, retry_rejected))
+        if not self.accepts(image):
+            return Detection(faces=(), driver_index=None)
+        return Detection(faces=(face_at(5.0),), driver_index=0)
+
+    def measure(self, inference: Detection) -> Detection:
+        return inference
+
+    def detect(self, image: np.ndarray, t_s: float | None = None) -> Detection:
+        return self.measure(self.infer(self.prepare(image), t_s))
+
+    def close(self) -> None:
+        pass
+
+
+NOISY_FLAT = noisy(FLAT[:, :, 0])
+
+
+def test_strong_smoothing_flattens_the_noise_and_keeps_an_edge() -> None:
+    """On a flat noisy frame with a step, the strong (bilateral) version keeps the step sharp
+    where the Gaussian spreads it, and leaves less grain; both stretch the levels alike."""
+    step = np.where(np.arange(640) < 320, 110, 150)[None, :] * np.ones((480, 1))
+    frame = noisy(step)
+    gaussian, strong = enhance(frame), enhance(frame, strong=True)
+    assert grain(strong) < 0.95 * grain(gaussian)
+    rows = slice(100, 380)  # the step between columns 319 and 320: kept in one pixel
+    rise = lambda image: float(image[rows, 320].mean() - image[rows, 319].mean())  # noqa: E731
+    assert rise(strong) > 120 > 2.0 * rise(gaussian)
+    assert abs(float(strong.mean()) - float(gaussian.mean())) < 3.0
+    clean = enhance(FLAT)  # no noise: no smoothing, the strong version is the same
+    np.testing.assert_array_equal(enhance(FLAT, strong=True), clean)
+
+
+def test_a_noisy_hard_still_is_looked_at_curved_then_strong_with_retries() -> None:
+    inner = SteppedDetector(lambda image: False)
+    assert FrontEndDetector(inner).detect(NOISY_FLAT).driver is None  # type: ignore[arg-type]
+    images = [image for _, image, _ in inner.seen]
+    assert len(images) == 2 and [retry for _, _, retry in inner.seen] == [True, True]
+    np.testing.assert_array_equal(images[0], enhance(NOISY_FLAT))
+    np.testing.assert_array_equal(images[1], enhance(NOISY_FLAT, strong=True))
+    clean = SteppedDetector(lambda image: False)  # no noise: as it came instead of strong
+    FrontEndDetector(clean).detect(FLAT)  # type: ignore[arg-type]
+    assert [(image.ndim, retry) for _, image, retry in clean.seen] == [(2, True), (3, False)]
+    good = SteppedDetector(lambda image: False)  # a good frame: as before, no retries
+    FrontEndDetector(good).detect(GOOD)  # type: ignore[arg-type]
+    assert [(image.ndim, retry) for _, image, retry in good.seen] == [(3, False), (2, False)]
+
+
+def test_a_stream_holds_the_strong_version_and_waits_without_a_face() -> None:
+    strong = enhance(NOISY_FLAT, strong=True)
+    smooth = lambda image: np.array_equal(image, strong)  # noqa: E731
+    inner = SteppedDetector(smooth)
+    front_end = FrontEndDetector(inner)  # type: ignore[arg-type]
+    assert front_end.detect(NOISY_FLAT, 0.0).driver is not None
+    assert [t for t, _, _ in inner.seen] == [0.0, pytest.approx(RETRY_STEP_S)]
+    for t_s in (0.1, 0.2):  # held: the strong version at once
+        assert front_end.detect(NOISY_FLAT, t_s).driver is not None
+    assert len(inner.seen) == 4 and smooth(inner.seen[-1][1])
+    never = SteppedDetector(lambda image: False)
+    front_end = FrontEndDetector(never)  # type: ignore[arg-type]
+    for index in range(12):
+        front_end.detect(NOISY_FLAT, index * 0.1)
+    # Two looks with retries at 0 s and at 1 s, one look without them in between.
+    retried = [round(t or 0.0, 1) for t, _, retry in never.seen if retry]
+    assert retried == [0.0, 0.0, 1.0, 1.0] and len(never.seen) == 12 + 2
 
 
 @pytest.fixture(scope="module")

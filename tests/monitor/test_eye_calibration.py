@@ -5,8 +5,6 @@ nothing."""
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 
@@ -19,7 +17,7 @@ from roadgaze.monitor.eye_calibration import (
     learn_calibration,
     thresholds_deg,
 )
-from roadgaze.monitor.neutral import learn_neutral
+from roadgaze.monitor.neutral import NeutralPose, learn_neutral
 from roadgaze.monitor.state import initial_state
 from roadgaze.types import EyeCalibrationStatus, EyesFeatures, PoseSample
 
@@ -141,12 +139,12 @@ def test_a_driver_whose_eyes_read_low_stays_on_the_road_and_a_glance_still_count
 def test_a_sweeping_head_teaches_neither_the_eyes_nor_the_neutral() -> None:
     monitor, _, trace = run([(5.0, eyes_of(eye_pitch=-25.0), 150.0)], config=CONFIG)
     assert trace[-1][2] is EyeCalibrationStatus.NONE
-    assert monitor.state.neutral_yaw_learned_s == 0.0
-    state = replace(initial_state(CONFIG), t_s=0.0)
-    fast = learn_neutral(CONFIG, state, -12.0, 10.0, 0.1, yaw_rate_dps=190.0)
-    steady = learn_neutral(CONFIG, state, -12.0, 10.0, 0.1, yaw_rate_dps=20.0)
-    assert fast == (0.0, 0.0, 0.0, 0.0)
-    assert steady[:2] == pytest.approx((-12.0, 10.0))
+    assert monitor.state.neutral.yaw_learned_s == 0.0
+    neutral = initial_state(CONFIG).neutral
+    fast = learn_neutral(CONFIG, neutral, 0.0, -12.0, 10.0, 0.1, yaw_rate_dps=190.0)
+    steady = learn_neutral(CONFIG, neutral, 0.0, -12.0, 10.0, 0.1, yaw_rate_dps=20.0)
+    assert fast == NeutralPose(0.0, 0.0, 0.0, 0.0)
+    assert (steady.yaw_deg, steady.pitch_deg) == pytest.approx((-12.0, 10.0))
 
 
 @pytest.mark.parametrize(

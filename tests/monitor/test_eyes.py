@@ -11,7 +11,7 @@ import pytest
 from fakes import eyes_of
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.eye_rules import classify_eyes, gaze_deg, soft_threshold
-from roadgaze.monitor.eyes import EyeMonitorState, clearable_eye_kinds, step_eyes
+from roadgaze.monitor.eyes import EyesAlone, clearable_eye_kinds, step_eyes
 from roadgaze.types import (
     AlertKind,
     EyeMeasurement,
@@ -57,11 +57,11 @@ def drive(
     segments: list[tuple[float, dict[str, object]]],
     speed_moving: bool = True,
     config: MonitorConfig = CONFIG,
-) -> tuple[list[tuple[float, AlertKind, str]], list[EyeMonitorState]]:
+) -> tuple[list[tuple[float, AlertKind, str]], list[EyesAlone]]:
     """Run segments of (seconds, eyes_of kwargs | {'face': False} | {'mp_pitch': deg, ...})."""
-    state = EyeMonitorState()
+    state = EyesAlone()
     events: list[tuple[float, AlertKind, str]] = []
-    states: list[EyeMonitorState] = []
+    states: list[EyesAlone] = []
     t = 0.0
     for seconds, kwargs in segments:
         end = t + seconds
@@ -74,7 +74,7 @@ def drive(
             state, raised = step_eyes(
                 config, state, sample(t, eyes, mp_pitch), speed_moving, on_road, 0.0, mp_pitch
             )
-            events += [(t, kind, reason) for kind, _, reason in raised]
+            events += [(t, event.kind, event.reason) for event in raised]
             states.append(state)
             t = round(t + 1 / FPS, 9)
     return events, states
@@ -169,7 +169,7 @@ def test_closure_ladder_fires_within_one_frame_of_each_threshold(
     assert [kind for _, kind, _ in events] == [kind for _, kind in expected]
     for (t, _, _), (after_s, _) in zip(events, expected, strict=True):
         assert 0.0 <= t - 2.0 - after_s < 1 / FPS + 1e-9
-    assert states[-1].closure_s() == 0.0 and states[-1].verdict.status is EyeStatus.OPEN
+    assert states[-1].eyes.closure_s() == 0.0 and states[-1].verdict.status is EyeStatus.OPEN
     assert AlertKind.MICROSLEEP in clearable_eye_kinds(states[-1], on_road=True)
     assert AlertKind.MICROSLEEP not in clearable_eye_kinds(states[-1], on_road=False)
 
@@ -201,7 +201,7 @@ def test_perclos_matches_the_closed_share_and_memory_stays_bounded() -> None:
     events, states = drive([(0.8, {}), (0.2, {"openness": 0.08})] * 120, config=config)
     last = states[-1]
     assert last.verdict.perclos == pytest.approx(0.2, abs=0.02)
-    assert len(last.bins) <= 61 and len(last.blinks) <= 61
+    assert len(last.eyes.bins) <= 61 and len(last.eyes.blinks) <= 61
     assert [kind for _, kind, _ in events] == [AlertKind.DROWSY]
     assert 30.0 - 1e-6 <= events[0][0] <= 31.0  # reported once 30 s are judged
     assert states[200].verdict.perclos is None  # 13 s judged: not yet
@@ -211,7 +211,7 @@ def test_long_blinks_make_drowsy_and_it_rearms() -> None:
     long_blinks = [(1.4, {}), (0.6, {"openness": 0.08})] * 3
     events, states = drive([(2.0, {}), *long_blinks, (70.0, {})])
     assert [kind for _, kind, _ in events] == [AlertKind.DROWSY]
-    assert states[-1].drowsy_armed
+    assert states[-1].drowsy.armed
     assert AlertKind.DROWSY in clearable_eye_kinds(states[-1], on_road=True)
 
 
@@ -237,7 +237,7 @@ def test_nothing_is_raised_when_not_moving() -> None:
 
 def test_the_eye_neutral_is_learned_on_the_road_and_gaze_uses_it() -> None:
     _, states = drive([(30.0, {"eye_yaw": -6.0, "eye_pitch": 3.0})])
-    neutral = states[-1].eye_neutral_deg
+    neutral = states[-1].eyes.eye_neutral_deg
     assert neutral == pytest.approx((-6.0, 3.0), abs=0.1)
     _, states = drive([(30.0, {"eye_yaw": -6.0}), (1.0, {"eye_yaw": -36.0})])
     assert states[-1].verdict.gaze_yaw_deg == pytest.approx(-20.0, abs=0.5)
@@ -247,7 +247,7 @@ def test_the_eye_neutral_is_learned_on_the_road_and_gaze_uses_it() -> None:
 
 
 def test_samples_out_of_order_are_ignored() -> None:
-    state, _ = step_eyes(CONFIG, EyeMonitorState(), sample(1.0, eyes_of()), True, True, 0.0, 0.0)
+    state, _ = step_eyes(CONFIG, EyesAlone(), sample(1.0, eyes_of()), True, True, 0.0, 0.0)
     again, events = step_eyes(CONFIG, state, sample(0.5, eyes_of()), True, True, 0.0, 0.0)
     assert again is state and events == ()
 

@@ -246,7 +246,7 @@ def test_face_lost_after_a_turn_is_off_road_not_unavailable() -> None:
     first_off = next(k / FPS for k in range(300) if (yaw_at(k / FPS) or 0.0) > 25.0)
     assert_within_one_frame(alerts[0].t_s, first_off + 3.0)
     assert_within_one_frame(alerts[1].t_s, 6.0)
-    assert monitor.state.gaze is Gaze.ON_ROAD
+    assert monitor.state.look.gaze is Gaze.ON_ROAD
 
 
 @pytest.mark.parametrize(("lost_s", "expected"), [(1.9, []), (2.5, ["driver_unavailable"])])
@@ -292,14 +292,14 @@ def test_neutral_settles_on_the_road_pose_then_follows_it_slowly() -> None:
     config = MonitorConfig()  # learning on, time constant 60 s
     monitor, alerts = run(lambda t: 18.0, 1.0, config)
     assert alerts == []
-    assert monitor.state.neutral_yaw_deg == pytest.approx(18.0)
+    assert monitor.state.neutral.yaw_deg == pytest.approx(18.0)
     for frame in range(30, round(120 * FPS)):
         monitor.update(sample(frame / FPS, 18.0))
     for frame in range(round(120 * FPS), round(180 * FPS)):
         monitor.update(sample(frame / FPS, 8.0))  # the road pose moves by 10 deg
     # 120 s learned: the running mean's gain is below the filter's, which moves 1 - e^-1 in 60 s.
-    assert monitor.state.neutral_yaw_deg == pytest.approx(8.0 + 10.0 * 2.718281828**-1, abs=0.1)
-    neutral = monitor.state.neutral_yaw_deg
+    assert monitor.state.neutral.yaw_deg == pytest.approx(8.0 + 10.0 * 2.718281828**-1, abs=0.1)
+    neutral = monitor.state.neutral.yaw_deg
     monitor.update(sample(180.0, neutral + 26.0))  # 26 deg from the neutral: off road
     assert monitor.state.on_road is False
     monitor.update(sample(181.0, neutral + 21.4))
@@ -311,10 +311,10 @@ def test_neutral_settles_on_the_road_pose_then_follows_it_slowly() -> None:
 def test_neutral_is_clamped_and_fixed_neutral_is_used_as_is() -> None:
     config = MonitorConfig(neutral_limit_deg=10.0)
     monitor, _ = run(lambda t: 20.0, 600.0, config)
-    assert monitor.state.neutral_yaw_deg == pytest.approx(10.0)
+    assert monitor.state.neutral.yaw_deg == pytest.approx(10.0)
     fixed = MonitorConfig(neutral_yaw_deg=30.0)
     monitor, _ = run(lambda t: 30.0, 10.0, fixed)
-    assert monitor.state.neutral_yaw_deg == 30.0
+    assert monitor.state.neutral.yaw_deg == 30.0
     assert monitor.state.on_road is True
     monitor.update(sample(10.0, 0.0))
     assert monitor.state.on_road is False
@@ -497,13 +497,13 @@ def test_pitch_neutral_is_learned_and_looking_down_is_the_lap() -> None:
     camera_low = 12.0  # the road-ahead pose seen from a camera below the line of sight
     monitor, alerts, zones = run_poses(lambda t: (0.0, camera_low), 3.0, config)
     assert alerts == [] and set(zones) == {"road"}
-    assert monitor.state.neutral_pitch_deg == pytest.approx(camera_low)
-    neutral = monitor.state.neutral_pitch_deg
+    assert monitor.state.neutral.pitch_deg == pytest.approx(camera_low)
+    neutral = monitor.state.neutral.pitch_deg
     monitor.update(sample(3.0, 0.0, 0, neutral - 19.0))
     assert monitor.verdict.zone == "lap"  # 19 deg below the neutral, 7 deg below the camera axis
     fixed = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=-5.0)
     monitor, _, zones = run_poses(lambda t: (0.0, -25.0), 2.0, fixed)
-    assert monitor.state.neutral_pitch_deg == -5.0 and zones[-1] == "lap"
+    assert monitor.state.neutral.pitch_deg == -5.0 and zones[-1] == "lap"
 
 
 def test_a_sample_without_pitch_is_judged_at_level_pitch() -> None:
@@ -519,9 +519,9 @@ def test_a_road_pose_outside_the_road_zone_at_first_is_still_learned() -> None:
     assert alerts == []
     assert zones[0] == "cluster" and zones[-1] == "road"
     assert zones.index("road") <= FPS  # within a second
-    assert monitor.state.neutral_pitch_deg == pytest.approx(-16.0)
+    assert monitor.state.neutral.pitch_deg == pytest.approx(-16.0)
     lap_glance, _, _ = run_poses(lambda t: (0.0, -16.0 if t < 2.0 else -45.0), 6.0, config)
-    assert lap_glance.state.neutral_pitch_deg == pytest.approx(-16.0)  # a lap glance does not teach
+    assert lap_glance.state.neutral.pitch_deg == pytest.approx(-16.0)  # a lap glance does not teach
     assert lap_glance.verdict.zone == "lap"
 
 
@@ -544,6 +544,6 @@ def test_a_turn_held_just_past_the_road_edge_early_in_a_drive_is_not_learned_as_
         return -27.8 + 0.15 * (t - 3.5) if t < 8.5 else -0.8  # as read: -27.8 drifting to -27.1
 
     monitor, alerts = run(yaw_at, 11.0, MonitorConfig())
-    assert monitor.state.neutral_yaw_deg > -3.0, monitor.state.neutral_yaw_deg
+    assert monitor.state.neutral.yaw_deg > -3.0, monitor.state.neutral.yaw_deg
     kinds = [a.kind for a in alerts]
     assert AlertKind.LONG_DISTRACTION in kinds

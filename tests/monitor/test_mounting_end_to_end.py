@@ -10,6 +10,7 @@ from typing import Any
 import pytest
 
 from roadgaze.config import Config, load_config
+from roadgaze.monitor.zones import ZoneMap
 from roadgaze.pose.mounting import gaze_to_camera, mounting_for
 from test_pipeline_synthetic import run_pipeline
 
@@ -40,4 +41,4 @@ def test_an_a_pillar_camera_sees_the_road_and_a_look_beyond_55_degrees(
     assert 3.0 + 1.5 <= alerts[0].t_s <= 3.0 + 3.6  # from the start of the turn
     assert alerts[0].rule == "euroncap.long_distraction"
     # Judged as if the camera were in front, the road pose (-35 deg) would be off the road.
-    assert Config().monitor.zone_map().classify(road_yaw, 0.0, "road") != "road"
+    assert ZoneMap.from_config(Config().monitor).classify(road_yaw, 0.0, "road") != "road"

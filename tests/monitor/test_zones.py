@@ -7,7 +7,7 @@ import pytest
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.zones import AWAY, DEFAULT_ZONES, ROAD, Zone, ZoneMap, classify_zone
 
-DEFAULTS = MonitorConfig().zone_map()
+DEFAULTS = ZoneMap.from_config(MonitorConfig())
 
 
 def test_the_configured_defaults_are_the_documented_table() -> None:

@@ -122,6 +122,10 @@ def test_each_role_does_what_it_may(
         time.sleep(0.5)
         link.publish_alert(alert_message(0, VEHICLE))
         assert wait_for(lambda: listener.seqs() == [0], timeout_s=10.0)
+        # The router lets the consumer's subscription reach the daemon: its matching status,
+        # hence its alert ledger, sees the FCW, and counts the alert delivered.
+        assert link.link_state.ever_matched
+        assert wait_for(lambda: link.status().alerts_waiting == 0, timeout_s=10.0)
 
         def speed_arrives() -> bool:
             provider.put(link.keys.speed, b'{"kmh": 50}')

@@ -60,7 +60,7 @@ def test_the_router_tells_plain_clients_once_on_stderr_and_writes_nothing_to_std
         told = reader.until("did not speak TLS", 30.0)
         router.send_signal(signal.SIGTERM)
         out, _ = router.communicate(timeout=30)
-        rest = [line for line in iter(lambda: reader.next(1.0), None)]
+        rest = reader.rest()
     finally:
         stop_process(router)
     assert out == ""

@@ -1,7 +1,7 @@
 """Capture-to-delivery latency of the yaw messages, through a Zenoh subscriber on loopback.
 
-`measure_latency` opens the service's own publishing (`roadgaze.daemon.bus_outputs`, a peer
-listening on a free 127.0.0.1 port) and, in a process of its own as a forward-collision system
+`measure_latency` builds the service's own run (`roadgaze.pipeline.build_run`, publishing as a
+peer listening on a free 127.0.0.1 port) and, in a process of its own as a forward-collision system
 would be, a Zenoh session connected to it whose subscriber takes each yaw message as it arrives.
 The latency of a frame is the time from the moment the loop received the frame from its source
 (`Pipeline.frame_received_s`, kept per frame by a `CaptureStamps` sink placed before the
@@ -20,16 +20,20 @@ import multiprocessing
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from roadgaze.benchmark.probes import CaptureStamps
 from roadgaze.config import Config
+
+if TYPE_CHECKING:
+    from roadgaze.capture import FrameSource
+    from roadgaze.pipeline import Run
 
 log = logging.getLogger(__name__)
 
@@ -184,34 +188,47 @@ def _subscriber_process(config: Config, connection: Connection) -> None:
 
 @dataclass(frozen=True, slots=True)
 class LatencyRig:
-    """What `measure_latency` yields: the sinks to run (stamps first) and the probe."""
+    """What `measure_latency` yields: the run to drive (`Run.run`) and the probe."""
 
-    sinks: tuple[Any, ...]
+    run: Run
     probe: YawLatencyProbe
     stamps: CaptureStamps
 
 
 @contextmanager
 def measure_latency(
-    config: Config, source_label: str, received_s: Callable[[], float]
+    config: Config, source_label: str, source: FrameSource | None = None
 ) -> Iterator[LatencyRig]:
-    """Publishing on loopback plus a subscriber measuring latency; `received_s` is the loop's
-    `frame_received_s` getter. The sinks yielded go to `Pipeline.run`; after the run call
-    `rig.probe.wait_for_count` and `rig.probe.result`."""
-    from roadgaze.daemon import bus_outputs
+    """The run as `roadgaze run` builds it (`build_run`, publishing on loopback; over `source`
+    when given, else the one `source_label` names) plus a subscriber measuring latency. Drive
+    `rig.run.run(realtime=True, ...)`, then call `rig.probe.wait_for_count` and
+    `rig.probe.result`."""
     from roadgaze.demo import demo_config, free_local_port, subscriber_config
+    from roadgaze.pipeline import RunOptions, build_run
 
     port = free_local_port()
     publishing = demo_config(config, port)
-    stamps = CaptureStamps(received_s, capacity=MAX_SAMPLES)
+    built: list[Run] = []
+    stamps = CaptureStamps(
+        lambda: built[0].pipeline.frame_received_s if built else math.nan, capacity=MAX_SAMPLES
+    )
+    options = RunOptions(source_label, command="bench", publish=True, quiet=True)
     with contextlib.ExitStack() as stack:
         # The subscriber closes after the service's session: a subscriber leaving first is a
         # link going down to the service, which warns that alerts are held.
         probes = stack.enter_context(contextlib.ExitStack())
-        bus = stack.enter_context(bus_outputs(publishing, source_label, publish=True))
+        run = stack.enter_context(
+            build_run(
+                publishing,
+                options,
+                source=source,
+                first_sinks=(stamps,),
+                sinks=(stamps.published_mark,),
+            )
+        )
+        built.append(run)
         probe = YawLatencyProbe(subscriber_config(publishing, port), stamps)
         probes.callback(probe.close)
         if not probe.wait_for_publisher(SUBSCRIBER_WAIT_S):
             log.warning("the latency subscriber did not see the publisher in time")
-        sinks = (stamps, *bus.sinks, stamps.published_mark)
-        yield LatencyRig(sinks=sinks, probe=probe, stamps=stamps)
+        yield LatencyRig(run=run, probe=probe, stamps=stamps)

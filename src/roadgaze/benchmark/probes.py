@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.types import Frame, FrameRecord, Sink
 
 
 def resident_mb() -> float:
@@ -29,7 +29,7 @@ def cpu_seconds() -> float:
     return time.process_time()
 
 
-class MemoryProbe:
+class MemoryProbe(Sink):
     """Samples VmRSS about once a second; the baseline is taken after `settle_s` of running."""
 
     def __init__(self, settle_s: float = 10.0) -> None:
@@ -58,7 +58,7 @@ class MemoryProbe:
         return None if self.baseline_mb is None else self.last_mb - self.baseline_mb
 
 
-class ThroughputProbe:
+class ThroughputProbe(Sink):
     """Frames per second and CPU milliseconds per frame after the first `warmup` records.
 
     The clock starts when record `warmup` (0-based) has been handed to the sinks and stops at the
@@ -120,7 +120,7 @@ class ThroughputProbe:
         return 1e3 * (self._last[1] - self._start[1]) / self.frames
 
 
-class CaptureStamps:
+class CaptureStamps(Sink):
     """Sink keeping, per frame index, when the loop received the frame and when its messages had
     been published (for latency).
 
@@ -160,7 +160,7 @@ class CaptureStamps:
         return None
 
 
-class _PublishedMark:
+class _PublishedMark(Sink):
     """The sink after the publisher: stamps when a frame's messages were handed to Zenoh."""
 
     def __init__(self, stamps: CaptureStamps) -> None:

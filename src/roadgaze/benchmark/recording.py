@@ -25,7 +25,7 @@ from typing import Any
 
 from roadgaze.config import Config
 from roadgaze.pipeline import RunSummary, Sink, StageTimings
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.types import Alert, Frame, FrameRecord
 
 KINDS = ("none", "records", "images")
 RECORDS_TARGET_MS = 0.2
@@ -80,6 +80,9 @@ class LoopTimed:
         self.sink.on_record(record, frame)
         self.cpu_s += time.thread_time() - started
         self.frames += 1
+
+    def on_alert(self, alert: Alert) -> None:
+        self.sink.on_alert(alert)
 
     def close(self) -> None:
         return None

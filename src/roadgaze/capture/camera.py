@@ -3,7 +3,9 @@
 A consumer slower than the camera gets the latest frame and the frames it missed are counted as
 drops, never queued. A camera that cannot be opened (when asked to wait for it) or that stops
 delivering is reported in `status`, re-opened with exponential backoff and resumed; `t_s` keeps
-counting from when the source was created, so one timeline spans every re-open.
+counting from when the source was created, so one timeline spans every re-open. A frame that
+comes a jump after the one before (beyond ten periods and 1 s, as for files) without the camera
+being reported lost is said in a warning and in `status`.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from roadgaze.capture.base import (
     as_bgr,
     finite_positive,
 )
+from roadgaze.capture.timebase import is_jump
 from roadgaze.config import CaptureConfig
 from roadgaze.errors import SourceError
 from roadgaze.types import Frame
@@ -78,6 +81,7 @@ class CameraSource(SourceBase):
             self._status = SourceStatus(ever_connected=True)
         self._t0_s = clock()
         self._last_t_s = -math.inf
+        self._lost_since_frame = False
         self._grabbed = 0
         width, height, fps = self.config.width, self.config.height, self.config.fps
         if self._capture is not None:
@@ -132,6 +136,7 @@ class CameraSource(SourceBase):
             ok, raw = (False, None) if capture is None else _safe_read(capture)
             if ok and raw is not None:
                 t_s = max(self._clock() - self._t0_s, self._last_t_s + 1e-6)
+                self._check_step(t_s)
                 self._last_t_s = t_s
                 frame = Frame(index=self._grabbed, t_s=t_s, image=as_bgr(raw))
                 self._grabbed += 1
@@ -146,6 +151,7 @@ class CameraSource(SourceBase):
             if capture is not None:
                 capture.release()
                 self._capture = None
+                self._lost_since_frame = True
                 message = f"camera {self.device} lost; reconnecting"
                 log.warning(message)
                 self._set_status(connected=False, message=message)
@@ -170,6 +176,26 @@ class CameraSource(SourceBase):
         with self._condition:
             self._status = replace(self._status, ended=True)
             self._condition.notify_all()
+
+    def _check_step(self, t_s: float) -> None:
+        """Say it when a frame comes a jump (`roadgaze.capture.timebase.is_jump`) after the one
+        before without the camera having been reported lost: a read that hung (a stalled
+        driver or machine). Its time is real; the monitor is told by the warning and the
+        status, not by a changed clock (the wall-clock stamps of recordings stay true)."""
+        step_s = t_s - self._last_t_s
+        lost, self._lost_since_frame = self._lost_since_frame, False
+        if (
+            lost
+            or not math.isfinite(step_s)
+            or not is_jump(step_s, 1.0 / (self._info.fps or self.config.fps))
+        ):
+            return
+        message = (
+            f"camera {self.device} delivered no frame for {step_s:.1f} s (a read that hung) "
+            f"until t={t_s:.3f} s"
+        )
+        log.warning(message)
+        self._set_status(message=message)
 
     def _set_status(self, **changes: Any) -> None:
         with self._condition:

@@ -26,7 +26,7 @@ from roadgaze.capture.base import (
     as_bgr,
     finite_positive,
 )
-from roadgaze.capture.timebase import TimeBase, check_avi_rate, sane_fps
+from roadgaze.capture.timebase import MAX_FPS, MIN_FPS, TimeBase, check_avi_rate, sane_fps
 from roadgaze.errors import SourceError
 from roadgaze.types import Frame
 
@@ -162,7 +162,8 @@ class ImageFolderSource(SourceBase):
     """The images of a folder in name order, as frames `index / fps` seconds apart.
 
     Unreadable images are skipped with a warning and counted in `status.frames_skipped`.
-    Raises `SourceError` when the folder holds no image.
+    Raises `SourceError` when the folder holds no image, or when `fps` could not time frames
+    (outside `MIN_FPS`..`MAX_FPS`, as for a video's rate).
     """
 
     def __init__(self, folder: str | Path, fps: float = 30.0) -> None:
@@ -171,6 +172,11 @@ class ImageFolderSource(SourceBase):
         self.folder = Path(folder)
         if not self.folder.is_dir():
             raise SourceError(f"image folder {self.folder} not found")
+        if sane_fps(fps) is None:  # its images are timed index / fps: nothing else times them
+            raise SourceError(
+                f"image folder {self.folder}: capture.fps {fps:g} cannot time its images (it "
+                f"must lie within {MIN_FPS:g} to {MAX_FPS:g}); e.g. --set capture.fps=30"
+            )
         self._paths = sorted(
             p for p in self.folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file()
         )

@@ -22,6 +22,13 @@ from typing import IO, Any
 from roadgaze.capture.base import SourceBase, SourceInfo, SourceStatus
 from roadgaze.capture.mcap_driver import DRIVER_TOPIC, RecordedDrivers
 from roadgaze.capture.mcap_images import IMAGE_SCHEMAS, CameraImage, ImageDecoder
+from roadgaze.capture.mcap_records import (
+    DEFAULT_MAX_CHUNK_MIB,
+    ChunkTooLargeError,
+    max_chunk_bytes,
+    top_level_records,
+)
+from roadgaze.capture.timebase import JoinedTimeBase, sane_fps
 from roadgaze.errors import SourceError
 from roadgaze.types import Frame
 
@@ -54,8 +61,14 @@ def _require_mcap(path: Path) -> None:
 class McapSource(SourceBase):
     """Every frame of an MCAP recording's camera channel (see the module doc)."""
 
-    def __init__(self, path: str | Path, topic: str | None = None) -> None:
+    def __init__(
+        self,
+        path: str | Path,
+        topic: str | None = None,
+        max_chunk_mib: float = DEFAULT_MAX_CHUNK_MIB,
+    ) -> None:
         self.path = Path(path)
+        self._max_chunk_bytes = max_chunk_bytes(max_chunk_mib)
         if not self.path.is_file():
             raise SourceError(f"MCAP recording {self.path} not found; pass an existing file")
         _require_mcap(self.path)
@@ -63,13 +76,17 @@ class McapSource(SourceBase):
         self._status = SourceStatus()
         self._truncation: str | None = None
         self._drivers = RecordedDrivers()  # the driver recorded with each frame (mcap_driver)
+        self._first_skip: str | None = None
+        """Why the first skipped camera frame was skipped."""
+        self._offset_seen = False
+        """Whether the recording's time offset was read (good or bad)."""
         try:
             self._handle: IO[bytes] | None = self.path.open("rb")
         except OSError as exc:
             raise SourceError(f"cannot read MCAP recording {self.path}: {exc.strerror}") from None
         try:
             summary, metadata = self._summary_and_metadata()
-            self.offset_ns: int | None = _offset_ns(metadata)
+            self.offset_ns: int | None = self._checked_offset(metadata)
             self.topic, self._count = self._choose_topic(summary)
             self._frames = self._read_frames()
             first = next(self._frames, None)
@@ -78,10 +95,12 @@ class McapSource(SourceBase):
             raise
         if first is None:
             self.close()
+            skipped = self._status.frames_skipped
             raise SourceError(
                 f"MCAP recording {self.path} holds no readable camera frame on "
                 f"{self.topic or 'an image channel'}"
                 + (f" (it is cut short: {self._truncation})" if self._truncation else "")
+                + (f" ({skipped} skipped: {self._first_skip})" if skipped else "")
             )
         self._first: CameraImage | None = first[0]
         self._first_log_ns = first[1]
@@ -89,7 +108,7 @@ class McapSource(SourceBase):
         self._info = SourceInfo(
             name=str(self.path),
             live=False,
-            fps=_fps(summary, self._count),
+            fps=sane_fps(_fps(summary, self._count)),
             frame_count=self._count,
             width=int(width),
             height=int(height),
@@ -138,45 +157,61 @@ class McapSource(SourceBase):
 
     def _read_frames(self) -> Iterator[tuple[CameraImage, int]]:
         """(frame, log time) of each camera message in file order, until the end or the first
-        unreadable record (a recording cut short)."""
+        unreadable record (a recording cut short). A chunk above `record.max_chunk_mib` raises
+        `ChunkTooLargeError` (roadgaze.capture.mcap_records)."""
         from mcap.records import Channel, Footer, Message, Metadata, Schema
-        from mcap.stream_reader import StreamReader
 
         assert self._handle is not None
         schemas: dict[int, Any] = {}
         decoders: dict[int, ImageDecoder] = {}
         driver_channels: set[int] = set()
-        reader = StreamReader(self._handle, skip_magic=False)
-        records = iter(reader.records)
+        records = top_level_records(self._handle, self._max_chunk_bytes, str(self.path))
         while True:
             try:
-                record = next(records, None)
+                item = next(records, None)
+            except ChunkTooLargeError:
+                raise
             except Exception as exc:  # cut short or damaged: what was read is kept
                 self._cut(exc)
                 return
-            if record is None:
+            if item is None:
                 # Ended between two records without the footer: the writer never closed it
                 # (`kill -9` or a power loss after a whole chunk), so it is cut short too.
                 self._truncation = self._truncation or "no footer after the last complete record"
                 return
-            if isinstance(record, Footer):
-                return
-            if isinstance(record, Schema):
-                schemas[record.id] = record
-            elif isinstance(record, Metadata) and self.offset_ns is None:
-                self.offset_ns = _offset_ns([record])
-            elif isinstance(record, Channel):
-                if record.topic == DRIVER_TOPIC:
-                    driver_channels.add(record.id)
-                decoder = self._decoder_of(record, schemas.get(record.schema_id))
-                if decoder is not None:
-                    decoders[record.id] = decoder
-            elif isinstance(record, Message) and record.channel_id in driver_channels:
-                self._drivers.note(record.log_time, record.data)
-            elif isinstance(record, Message) and record.channel_id in decoders:
-                decoded = self._decode(decoders[record.channel_id], record)
-                if decoded is not None:
-                    yield decoded
+            for record in item[1]:
+                if isinstance(record, Footer):
+                    return
+                if isinstance(record, Schema):
+                    schemas[record.id] = record
+                elif isinstance(record, Metadata) and not self._offset_seen:
+                    self.offset_ns = self._checked_offset([record])
+                elif isinstance(record, Channel):
+                    if record.topic == DRIVER_TOPIC:
+                        driver_channels.add(record.id)
+                    decoder = self._decoder_of(record, schemas.get(record.schema_id))
+                    if decoder is not None:
+                        decoders[record.id] = decoder
+                elif isinstance(record, Message) and record.channel_id in driver_channels:
+                    self._drivers.note(record.log_time, record.data)
+                elif isinstance(record, Message) and record.channel_id in decoders:
+                    decoded = self._decode(decoders[record.channel_id], record)
+                    if decoded is not None:
+                        yield decoded
+
+    def _checked_offset(self, metadata: list[Any]) -> int | None:
+        """The recording's time offset; a malformed one is said in a warning and ignored (the
+        frames' own stamps still time the drive, from its first frame)."""
+        value, problem = _offset_ns(metadata)
+        self._offset_seen = self._offset_seen or value is not None or problem is not None
+        if problem is not None:
+            log.warning(
+                "MCAP recording %s: its roadgaze time_offset_ns %s: ignored; the drive is "
+                "timed from its first frame",
+                self.path,
+                problem,
+            )
+        return value
 
     def _decoder_of(self, channel: Any, schema: Any) -> ImageDecoder | None:
         if schema is None or schema.name not in IMAGE_SCHEMAS:
@@ -190,8 +225,8 @@ class McapSource(SourceBase):
     def _decode(self, decoder: ImageDecoder, message: Any) -> tuple[CameraImage, int] | None:
         try:
             frame = decoder.decode(message.data)
-        except SourceError:
-            raise
+        except SourceError as exc:  # e.g. a RawImage whose bytes do not fill its size
+            frame, reason = None, str(exc)
         except Exception as exc:  # a damaged message: skipped like an unreadable image
             frame, reason = None, f"{type(exc).__name__}: {exc}"
         else:
@@ -203,6 +238,7 @@ class McapSource(SourceBase):
                 self.path,
                 reason,
             )
+            self._first_skip = self._first_skip or reason
             self._status = replace(self._status, frames_skipped=self._status.frames_skipped + 1)
             return None
         return frame, message.log_time
@@ -216,8 +252,8 @@ class McapSource(SourceBase):
                 f"MCAP recording {self.path} can be iterated only once; open it again"
             )
         self._iterated = True
-        period_s = 1.0 / (self._info.fps or 30.0)
-        first_ns = None
+        time_base = JoinedTimeBase(f"MCAP recording {self.path}", self._info.fps)
+        origin_ns: int | None = None
         previous_t_s: float | None = None
         index = 0
         item: tuple[CameraImage, int] | None = (
@@ -227,31 +263,63 @@ class McapSource(SourceBase):
         while item is not None:
             camera, log_ns = item
             stamp_ns = camera.stamp_ns or log_ns
-            if self.offset_ns is None:
-                first_ns = stamp_ns if first_ns is None else first_ns
-                t_s = (stamp_ns - first_ns) / 1e9
-            else:
-                t_s = (stamp_ns - self.offset_ns) / 1e9
-            if previous_t_s is not None and t_s <= previous_t_s:
-                t_s = previous_t_s + period_s
+            if origin_ns is None:  # the timeline is chosen once, at the first frame
+                origin_ns = self._origin_ns(stamp_ns)
+            t_s = time_base.t_s(index, (stamp_ns - origin_ns) / 1e9)
+            if time_base.breaks and self._status.message is None:
+                message = (
+                    f"MCAP recording {self.path}: {time_base.first_break}: the clock is joined "
+                    "across it"
+                )
+                self._status = replace(self._status, message=message)
             self._status = replace(self._status, frames_delivered=index + 1)
             yield Frame(index, t_s, camera.image, self._drivers.take(log_ns))
             previous_t_s = t_s
             index += 1
             item = next(self._frames, None)
-        self._finish(index, previous_t_s)
+        self._finish(index, previous_t_s, time_base)
 
-    def _finish(self, delivered: int, last_t_s: float | None) -> None:
-        cut = self._truncation
-        message = None
-        if cut is not None:
-            message = (
-                f"MCAP recording {self.path} is cut short ({cut}): read {delivered} frames, "
-                f"stopped after t={last_t_s or 0.0:.3f} s; `roadgaze recover` makes it whole"
+    def _origin_ns(self, first_stamp_ns: int) -> int:
+        """Where the drive's time 0 lies: the recording's time offset, or its first frame when
+        it has none or the offset lies after the first frame (it is then not this recording's;
+        said in a warning)."""
+        if self.offset_ns is not None and first_stamp_ns < self.offset_ns:
+            log.warning(
+                "MCAP recording %s: its time_offset_ns (%d) lies after its first frame's stamp "
+                "(%d ns): ignored; the drive is timed from its first frame",
+                self.path,
+                self.offset_ns,
+                first_stamp_ns,
             )
-            log.warning(message)
+            self.offset_ns = None
+        return first_stamp_ns if self.offset_ns is None else self.offset_ns
+
+    def _finish(self, delivered: int, last_t_s: float | None, time_base: JoinedTimeBase) -> None:
+        """The status at the end: cut short, clock breaks and skipped frames, in one message
+        (a replay's closing lines and a batch's warnings show it)."""
+        problems = []
+        if self._truncation is not None:
+            problems.append(
+                f"cut short ({self._truncation}): read {delivered} frames, stopped after "
+                f"t={last_t_s or 0.0:.3f} s; `roadgaze recover` makes it whole"
+            )
+            log.warning("MCAP recording %s is %s", self.path, problems[-1])
+        if time_base.breaks:
+            problems.append(
+                f"its clock was joined across {time_base.breaks} "
+                f"break{'s' if time_base.breaks > 1 else ''} (the first: {time_base.first_break})"
+            )
+        skipped = self._status.frames_skipped
+        if skipped:
+            problems.append(
+                f"{skipped} camera frame{'s' if skipped > 1 else ''} skipped (the first: "
+                f"{self._first_skip})"
+            )
         self._status = replace(
-            self._status, ended=True, truncated=message is not None, message=message
+            self._status,
+            ended=True,
+            truncated=self._truncation is not None,
+            message=f"MCAP recording {self.path}: {'; '.join(problems)}" if problems else None,
         )
 
     def close(self) -> None:
@@ -260,15 +328,20 @@ class McapSource(SourceBase):
             self._handle = None
 
 
-def _offset_ns(metadata: list[Any]) -> int | None:
-    """The `roadgaze` metadata's `time_offset_ns`; None when the recording has none."""
+def _offset_ns(metadata: list[Any]) -> tuple[int | None, str | None]:
+    """The `roadgaze` metadata's `time_offset_ns` (None when the recording has none), and what
+    is wrong with it when it is not a time (an integer of 0 to 2^64 - 1 ns, as MCAP's times)."""
     for record in metadata:
         if record.name == "roadgaze" and "time_offset_ns" in record.metadata:
+            text = str(record.metadata["time_offset_ns"])
             try:
-                return int(record.metadata["time_offset_ns"])
+                value = int(text)
             except ValueError:
-                return None
-    return None
+                return None, f"{text[:40]!r} is not an integer"
+            if not 0 <= value < 1 << 64:
+                return None, f"{text[:40]} ns lies outside MCAP's times (0 to 2^64 - 1 ns)"
+            return value, None
+    return None, None
 
 
 def _fps(summary: Any, count: int | None) -> float | None:

@@ -40,6 +40,6 @@ def open_source(
 def open_file(path: Path, config: Config | None = None) -> FrameSource:
     """A file as a drive: an MCAP recording (by its magic bytes) or a video file."""
     if is_mcap(path):
-        topic = config.record.camera_topic if config is not None else None
-        return McapSource(path, topic)
+        config = config if config is not None else Config()
+        return McapSource(path, config.record.camera_topic, config.record.max_chunk_mib)
     return VideoFileSource(path)

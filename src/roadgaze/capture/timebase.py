@@ -8,14 +8,17 @@ previous one: going backwards, standing still (a stall), a step shorter than one
 falls back to frame-index time (`index / fps`, continuing from the last good time) when the
 container's frame rate is sane (`MIN_FPS`..`MAX_FPS`), and says so once; with no sane rate
 either it raises `SourceError` (neither clock can time the monitor). A missing timestamp counts
-as a flag too. Pure: no OpenCV.
+as a flag too. `JoinedTimeBase` checks a recording's own stamps (an MCAP drive) by the same
+rule and joins each break instead (its frames need not be evenly spaced). Pure: no OpenCV.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+import statistics
 import struct
+from collections import deque
 from pathlib import Path
 
 from roadgaze.errors import SourceError
@@ -30,6 +33,9 @@ JUMP_MIN_S = 1.0
 """A step between two frames is a jump when it exceeds both JUMP_PERIODS frame periods and
 JUMP_MIN_S seconds (a variable-rate recording's hiccup stays below)."""
 
+PERIOD_WINDOW = 31
+"""A recording's frame period is the median of this many last accepted steps."""
+
 AVI_HEADER_BYTES = 16 * 1024
 """How much of an AVI file is read for its stream headers."""
 
@@ -39,6 +45,39 @@ def sane_fps(fps: float | None) -> float | None:
     if fps is None or not math.isfinite(fps) or not MIN_FPS <= fps <= MAX_FPS:
         return None
     return fps
+
+
+def is_jump(step_s: float, period_s: float) -> bool:
+    """Whether a step between two frames is a jump: beyond JUMP_PERIODS periods and
+    JUMP_MIN_S."""
+    return step_s > JUMP_PERIODS * period_s and step_s > JUMP_MIN_S
+
+
+def step_problem(
+    index: int, previous_t_s: float | None, t_s: float | None, period_s: float | None
+) -> str | None:
+    """What is wrong with frame `index`'s time `t_s` after `previous_t_s` (None: it is the
+    first), or None when nothing is. A step is a jump beyond JUMP_PERIODS periods of `period_s`
+    and JUMP_MIN_S; without a period, beyond JUMP_MIN_S."""
+    if t_s is None or not math.isfinite(t_s) or t_s < 0:
+        return f"frame {index} has no valid timestamp"
+    if previous_t_s is None:
+        return None
+    step_s = t_s - previous_t_s
+    if step_s < 0:
+        return f"timestamps go backwards at frame {index} ({previous_t_s:.3f} s -> {t_s:.3f} s)"
+    if step_s == 0:
+        return f"timestamps stall at frame {index} (t = {t_s:.3f} s twice)"
+    if step_s < 1.0 / MAX_FPS:
+        return f"timestamps step only {step_s * 1000:.3f} ms at frame {index}"
+    if period_s is None:
+        return f"timestamps step {step_s:.3f} s at frame {index}" if step_s > JUMP_MIN_S else None
+    if is_jump(step_s, period_s):
+        return (
+            f"timestamps jump {step_s:.3f} s at frame {index}, {step_s / period_s:.0f} "
+            f"periods of {1.0 / period_s:g} fps"
+        )
+    return None
 
 
 class TimeBase:
@@ -89,29 +128,8 @@ class TimeBase:
         self._previous_t_s = t_s
 
     def _problem(self, index: int, t_s: float | None) -> str | None:
-        if t_s is None or not math.isfinite(t_s) or t_s < 0:
-            return f"frame {index} has no valid timestamp"
-        previous = self._previous_t_s
-        if previous is None:
-            return None
-        step_s = t_s - previous
-        if step_s < 0:
-            return f"timestamps go backwards at frame {index} ({previous:.3f} s -> {t_s:.3f} s)"
-        if step_s == 0:
-            return f"timestamps stall at frame {index} (t = {t_s:.3f} s twice)"
-        if step_s < 1.0 / MAX_FPS:
-            return f"timestamps step only {step_s * 1000:.3f} ms at frame {index}"
-        if self.fps is None and step_s > JUMP_MIN_S:  # under 1 fps: no use to the monitor
-            return f"timestamps step {step_s:.3f} s at frame {index}"
-        if self.fps is None:
-            return None
-        period_s = 1.0 / self.fps
-        if step_s > JUMP_PERIODS * period_s and step_s > JUMP_MIN_S:
-            return (
-                f"timestamps jump {step_s:.3f} s at frame {index}, {step_s / period_s:.0f} "
-                f"periods of {self.fps:g} fps"
-            )
-        return None
+        period_s = None if self.fps is None else 1.0 / self.fps
+        return step_problem(index, self._previous_t_s, t_s, period_s)
 
     def _fall_back(self, index: int, problem: str) -> None:
         if self.fps is None:
@@ -132,6 +150,65 @@ class TimeBase:
             problem,
             self.fps,
         )
+
+
+class JoinedTimeBase:
+    """Frame times from a recording's own stamps (an MCAP drive), joined across breaks.
+
+    A recording's frames are not evenly spaced (frames dropped while recording, a slow image
+    rate), so a break is not replaced by frame-index time as in `TimeBase`: each stamp is
+    checked against the previous frame's time by `step_problem`, with the period of the last
+    accepted steps (their median; before any, `fps` when sane, else 1 s). A bad step (backwards,
+    a stall, a missing stamp, or a jump: a clock stepped on the vehicle, a hostile file) never
+    reaches the monitor: that frame is timed one period after the previous frame and the
+    frames after it keep their own spacing from there (the clock is re-based). The first break
+    is logged (and kept in `first_break`), the count in `breaks`. Pure.
+    """
+
+    def __init__(self, name: str, fps: float | None) -> None:
+        self.name = name
+        rate = sane_fps(fps)
+        self._seed_period_s = 1.0 / rate if rate is not None else 1.0 / MIN_FPS
+        self._steps_s: deque[float] = deque(maxlen=PERIOD_WINDOW)
+        self._shift_s = 0.0
+        self._previous_t_s: float | None = None
+        self.breaks = 0
+        self.first_break: str | None = None
+
+    @property
+    def period_s(self) -> float:
+        """The recording's frame period: the median of the last accepted steps."""
+        return statistics.median(self._steps_s) if self._steps_s else self._seed_period_s
+
+    def t_s(self, index: int, stamp_s: float | None) -> float:
+        """The time of frame `index` whose own stamp is `stamp_s` (None when it has none)."""
+        t_s = None if stamp_s is None else stamp_s - self._shift_s
+        previous = self._previous_t_s
+        problem = step_problem(index, previous, t_s, self.period_s)
+        if problem is None:
+            assert t_s is not None
+            if previous is not None:
+                self._steps_s.append(t_s - previous)
+        else:
+            t_s = 0.0 if previous is None else previous + self.period_s
+            if stamp_s is not None and math.isfinite(stamp_s):
+                self._shift_s = stamp_s - t_s
+            self._break(problem)
+        self._previous_t_s = t_s
+        return t_s
+
+    def _break(self, problem: str) -> None:
+        self.breaks += 1
+        if self.first_break is None:
+            self.first_break = problem
+            log.warning(
+                "%s: %s: that frame is timed %.3f s after the one before and the clock goes on "
+                "from there (the monitor's timers never run across the break; further breaks "
+                "are counted)",
+                self.name,
+                problem,
+                self.period_s,
+            )
 
 
 def check_avi_rate(path: Path) -> None:

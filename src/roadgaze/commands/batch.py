@@ -115,7 +115,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     if args.ray_address is not None and args.engine != "ray":
         raise ConfigError("--ray-address needs --engine ray")
     if args.engine == "ray":
-        from roadgaze.fleet.engines import import_ray
+        from roadgaze.fleet.executors import import_ray
 
         import_ray(args.ray_address)  # a missing Ray is a bad argument, said before any work
     drives = discover_drives(args.input)

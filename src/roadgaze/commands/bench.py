@@ -7,8 +7,7 @@ import json
 import logging
 import math
 import statistics
-from collections.abc import Callable, Sequence
-from contextlib import closing
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -230,27 +229,25 @@ def pipeline_pass(
     config: Config,
     sinks: list[Any],
     timings: StageTimings,
-    received_s: list[Callable[[], float]] | None = None,
-    realtime: bool = False,
 ) -> PassResult:
-    """One pass of the loop with a fresh detector (model start-up not timed); `received_s[0]`
-    is set to the pipeline's `frame_received_s`; `realtime` paces a file at its frame rate."""
+    """One pass of the loop as fast as it goes, built by `build_run` with a fresh detector
+    (model start-up not timed) and no outputs but `sinks`."""
     from roadgaze.benchmark import ThroughputProbe
-    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.pipeline import RunOptions, build_run
 
     throughput = ThroughputProbe(args.warmup)
-    with open_bench_source(args, config) as source, closing(create_detector(config)) as detector:
-        pipeline = Pipeline.from_config(config, detector)
-        if received_s is not None:
-            received_s[0] = lambda: pipeline.frame_received_s
-        log.info("pipeline pass over %s%s", args.source, " at its frame rate" if realtime else "")
-        summary = pipeline.run(source, [*sinks, throughput], timings=timings, realtime=realtime)
+    options = RunOptions(args.source, command="bench", quiet=True)
+    source = open_bench_source(args, config)
+    with build_run(config, options, source=source, sinks=[*sinks, throughput]) as run:
+        log.info("pipeline pass over %s", args.source)
+        summary = run.run(timings=timings)
+        engine = getattr(run.pipeline.detector, "engine", None)
     return PassResult(
         summary,
         throughput.fps,
         throughput.cpu_ms_per_frame,
         throughput.median_interval_ms,
-        getattr(detector, "engine", None),
+        engine,
     )
 
 
@@ -274,11 +271,10 @@ def latency_pass(args: argparse.Namespace, config: Config) -> LatencyPass:
     from roadgaze.benchmark import measure_latency
     from roadgaze.pipeline import StageTimings
 
-    received_s: list[Callable[[], float]] = [lambda: math.nan]
     timings = StageTimings(skip_first=args.warmup)
-    with measure_latency(config, args.source, lambda: received_s[0]()) as rig:
-        result = pipeline_pass(args, config, list(rig.sinks), timings, received_s, realtime=True)
-        published = result.summary.frames
+    with measure_latency(config, args.source, open_bench_source(args, config)) as rig:
+        log.info("pipeline pass over %s at its frame rate", args.source)
+        published = rig.run.run(timings=timings, realtime=True).frames
         rig.probe.wait_for_count(published, 5.0)
         latency = rig.probe.result(published, skip_first=args.warmup)
     return LatencyPass(latency, timings.stats())

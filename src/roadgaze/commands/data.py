@@ -10,18 +10,6 @@ from roadgaze.commands.options import common_options
 from roadgaze.config import Config
 
 
-def _subjects(text: str) -> list[int]:
-    """`1-10` or `1,3,5` (or both mixed) as subject numbers."""
-    numbers: list[int] = []
-    try:
-        for part in text.split(","):
-            low, _, high = part.partition("-")
-            numbers.extend(range(int(low), int(high or low) + 1))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected e.g. 1-10 or 1,3,5, found {text!r}") from None
-    return numbers
-
-
 def register(subparsers: Any) -> None:
     from pathlib import Path
 
@@ -38,7 +26,8 @@ def register(subparsers: Any) -> None:
         help="Pointing'04 (Head Pose Image Database): images and ground_truth.csv",
         description="Find every image named personne<PP><S><II><tilt><pan>.jpg under SRC (the "
         "unpacked Head Pose Image Database of Gourier, Hall and Crowley 2004), copy it to "
-        "OUT/images/PersonPP/ and write OUT/ground_truth.csv with the columns file, yaw_deg, "
+        "OUT/images/PersonPP/ (OUT outside SRC; symbolic links under SRC are skipped, never "
+        "followed) and write OUT/ground_truth.csv with the columns file, yaw_deg, "
         "pitch_deg, pan_label, tilt_label, subject, series. yaw_deg = -pan (the archive's pan "
         "is positive turned to the subject's own right, roadgaze's yaw to their own left); "
         "pitch_deg = tilt. Then: roadgaze eval OUT. With OUT = $ROADGAZE_DATA/pointing04-dev, "
@@ -48,9 +37,9 @@ def register(subparsers: Any) -> None:
     pointing04.add_argument("out", type=Path, metavar="OUT")
     pointing04.add_argument(
         "--subjects",
-        type=_subjects,
         metavar="LIST",
-        help="only these subjects, e.g. 1-10 (the development half the README's figures use)",
+        help="only these subjects (1-15), e.g. 1-10 (the development half the README's "
+        "figures use)",
     )
     pointing04.add_argument(
         "--symlink", action="store_true", help="link the images instead of copying them"
@@ -59,16 +48,22 @@ def register(subparsers: Any) -> None:
 
 
 def run_pointing04(args: argparse.Namespace, config: Config) -> int:
-    from roadgaze.evaluation.pointing04 import build_evaluation_set, find_images
+    from roadgaze.evaluation.pointing04 import (
+        build_evaluation_set,
+        check_folders,
+        find_images,
+        parse_subjects,
+    )
     from roadgaze.logs import log_written
 
-    images = find_images(args.source, args.subjects)
+    subjects = None if args.subjects is None else parse_subjects(args.subjects)
+    check_folders(args.source, args.out)
+    images = find_images(args.source, subjects)
     csv_path = build_evaluation_set(images, args.out, symlink=args.symlink)
-    subjects = sorted({image.subject for image in images})
     logging.getLogger(__name__).info(
         "%d images of subjects %s in %s (yaw_deg = -pan)",
         len(images),
-        ",".join(map(str, subjects)),
+        ",".join(map(str, sorted({image.subject for image in images}))),
         args.out,
     )
     log_written(csv_path)

@@ -60,7 +60,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     def alert(message: dict[str, Any]) -> None:
         print(f"demo: {format_alert(message)}", flush=True)
 
-    with records_dropped("roadgaze.daemon", lambda record: hasattr(record, "alert")):
+    with records_dropped("roadgaze.demo", lambda record: hasattr(record, "alert")):
         result = run_demo(
             args.out,
             config,

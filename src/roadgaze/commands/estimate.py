@@ -37,8 +37,9 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.evaluation import estimate_images
     from roadgaze.landmarks.model_store import resolve_model
+    from roadgaze.pose.geometry import FaceModelConstants
 
-    constants = config.geometry.face_constants()
+    constants = FaceModelConstants.from_config(config.geometry)
     model_path = resolve_model(config.model)
     jobs = [(path, str(path)) for path in args.images]
     failures = 0

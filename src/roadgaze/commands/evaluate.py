@@ -79,7 +79,8 @@ def register(subparsers: Any) -> None:
         metavar="NAME",
         help="run the condition suite instead: the images with |yaw| <= 60, clean and under "
         "this cabin condition (repeatable, or `all`: ir_grey, dark, glare, motion_blur, jpeg, "
-        "low_res, sunglasses, mask; docs/conditions.md), one table row each",
+        "low_res, sunglasses, mask; docs/conditions.md), one table row each; NAME:KEY=VALUE,... "
+        "sets a condition's parameters, e.g. ir_grey:noise_std=9",
     )
     parser.set_defaults(handler=run)
 
@@ -103,6 +104,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.evaluation.pointing04 import DATA_ENV, default_dataset
     from roadgaze.landmarks import CANDIDATE_CHOICES
     from roadgaze.landmarks.model_store import resolve_model
+    from roadgaze.pose.geometry import FaceModelConstants
 
     if args.task == "phone":
         from roadgaze.commands.evaluate_phone import run_phone
@@ -135,7 +137,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
             f"none of the {len(truths)} images listed in {args.dataset / 'ground_truth.csv'} "
             f"exists under {args.dataset} (first: {truths[0].file}); check the folder"
         )
-    constants = config.geometry.face_constants()
+    constants = FaceModelConstants.from_config(config.geometry)
     model_path = resolve_model(config.model)
     if args.condition:
         return run_conditions(args, config, truths, model_path)
@@ -205,6 +207,7 @@ def run_conditions(
     from roadgaze.evaluation.condition_suite import (
         estimate_conditions,
         format_condition_table,
+        format_subject_table,
         score_conditions,
         suite_truths,
     )
@@ -227,6 +230,9 @@ def run_conditions(
         f"landmarks.enhance = {config.landmarks.enhance}"
     )
     print(format_condition_table(table))
+    by_subject = format_subject_table(table)
+    if by_subject is not None:
+        print(f"\n{by_subject}")
     if args.report is not None:
         document = {
             "dataset": str(args.dataset),

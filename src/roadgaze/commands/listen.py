@@ -1,10 +1,10 @@
 """`roadgaze listen`: print what a Zenoh subscriber receives from roadgaze daemons, checked.
 
-Alerts come through Zenoh's advanced subscriber (history: the last alerts when it joins or when
-a daemon appears; recovery: alerts missed during a link outage), so every alert is printed once,
-in `seq` order. Every message is checked (`MessageChecker`) before it is printed; rejected ones
-are reported on stderr. By default `listen` is a client of the rendezvous endpoint
-(tcp/127.0.0.1:7447), where `roadgaze run` listens or a router runs.
+What is received, checked and ordered comes from `roadgaze.transport.consumer.AlertConsumer`
+(history, recovery, gaps, duplicates, forged and second publishers); this module prints its
+events: checked messages on stdout, what was not printed (and why) on stderr, the totals at
+exit. By default `listen` is a client of the rendezvous endpoint (tcp/127.0.0.1:7447), where
+`roadgaze run` listens or a router runs.
 """
 
 from __future__ import annotations
@@ -13,12 +13,10 @@ import argparse
 import json
 import logging
 import math
-import queue
 import sys
 import time
 from typing import Any
 
-from roadgaze.commands.listen_alerts import AlertBook
 from roadgaze.commands.listen_lines import format_pretty as format_pretty
 from roadgaze.commands.listen_lines import format_vss as format_vss
 from roadgaze.commands.options import (
@@ -32,14 +30,6 @@ from roadgaze.transport.checks import vehicle_of
 from roadgaze.transport.session import unreachable_hint
 
 log = logging.getLogger("roadgaze.listen")
-QUEUE_SIZE = 10_000
-VSS_MAX_BYTES = 256
-"""A VSS value is a short text; anything longer is refused unread."""
-LEFT_HOLD_S = 0.5
-"""An `alive ... left` waits this long for the vehicle's final state, printed before it."""
-ALIVE_HISTORY_S = 0.5
-"""At start, how long the liveliness history may take before alerts are subscribed (so a
-running daemon's `alive ... joined` comes before its cached alerts)."""
 
 
 def register(subparsers: Any) -> None:
@@ -80,6 +70,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     from roadgaze.errors import TransportError
     from roadgaze.service.signals import StopFlag, signal_handlers
     from roadgaze.transport import Keys, build_zenoh_config, open_session, plan_session
+    from roadgaze.transport.consumer import AlertConsumer
 
     # Non-UTF-8 text (a lone surrogate in a hostile payload) is escaped, never a crash.
     for stream in (sys.stdout, sys.stderr):
@@ -117,260 +108,125 @@ def run(args: argparse.Namespace, config: Config) -> int:
             _say(f"connected to nothing ({endpoints}) in {timeout_s:g} s: {unreachable_hint(plan)}")
             return 1
         with session:
-            listener = _Listener(args, zconf.prefix, keys, session, zconf.alert_cache_size, plan)
-            if zconf.vss:
-                listener.vss_prefix = zconf.vss_prefix
-            remaining_s = None if timeout_s is None else timeout_s - (time.monotonic() - started)
-            try:
+            consumer = AlertConsumer(
+                session,
+                keys,
+                zconf.prefix,
+                history=zconf.alert_cache_size,
+                yaw=not args.no_yaw,
+                vss_prefix=zconf.vss_prefix if zconf.vss else None,
+            )
+            with consumer:
+                printer = Printer(args, consumer)
+                elapsed_s = time.monotonic() - started
+                remaining_s = None if timeout_s is None else timeout_s - elapsed_s
                 if args.query_state:
-                    return listener.query_state(max(0.5, remaining_s or 0.0))
-                return listener.follow(remaining_s, stop, endpoints)
-            finally:
-                listener.close()
+                    from roadgaze.commands.listen_query import query_state
+
+                    return query_state(printer, max(0.5, remaining_s or 0.0))
+                return printer.follow(remaining_s, stop, endpoints, plan)
 
 
-class _Listener:
-    """The subscriptions of one `listen` run and the printing of what they receive."""
+class Printer:
+    """Prints the events of one `listen` run: checked messages on stdout, the rest on stderr."""
 
-    def __init__(
-        self,
-        args: argparse.Namespace,
-        prefix_template: str,
-        keys: Any,
-        session: Any,
-        history: int,
-        plan: Any = None,
-    ) -> None:
-        import zenoh
-
-        from roadgaze.transport import MESSAGE_MAX_BYTES, ThrottledWarning
-        from roadgaze.transport.checks import MessageChecker
+    def __init__(self, args: argparse.Namespace, consumer: Any) -> None:
+        from roadgaze.transport import ThrottledWarning
 
         self.args = args
-        self.plan = plan
-        self.keys = keys
-        self.session = session
-        self.prefix_template = prefix_template
-        self.history = history
-        self.checker = MessageChecker(prefix_template)
-        self.max_bytes = MESSAGE_MAX_BYTES
-        self.received: queue.Queue[tuple[str, str, bytes | int, str | None]] = queue.Queue(
-            QUEUE_SIZE
-        )
-        self.dropped = 0
-        self.connected: set[str] = set()
-        self.ever_connected = False
+        self.consumer = consumer
         self.warn = ThrottledWarning(log, "roadgaze listen: message rejected", period_s=5.0)
-        self.book = AlertBook()
-        self._left: dict[str, tuple[float, str, dict[str, Any]]] = {}
-        """Vehicle -> (deadline, key, payload) of an `alive ... left` held for its final state."""
-        self._alive_seen = False
-        self.vss_prefix: str | None = None
-        """With --vss: the prefix of the VSS keys ('' for the bare paths); None: not shown."""
-        self._sample_kind_put = zenoh.SampleKind.PUT
-        self.entities: list[Any] = [
-            session.info.declare_transport_events_listener(self._on_transport, history=True)
-        ]
 
-    def _on_transport(self, event: Any) -> None:
-        zid = str(event.transport.zid)
-        whatami = str(event.transport.whatami).rsplit(".", 1)[-1].lower()
-        if event.kind == self._sample_kind_put:
-            self.connected.add(zid)
-            self.ever_connected = True
-            log.info("roadgaze listen: connected to %s %s", whatami, zid)
-        else:
-            self.connected.discard(zid)
-            log.warning("roadgaze listen: %s %s gone; waiting for it to come back", whatami, zid)
-
-    def _emit(self, kind: str, key: str, data: bytes | int, source: str | None = None) -> None:
-        try:
-            self.received.put_nowait((kind, key, data, source))
-        except queue.Full:
-            self.dropped += 1
-
-    def _on_sample(self, sample: Any) -> None:
-        """O(1): size check before any copy, then hand over to the printing loop."""
-        key = str(sample.key_expr)
-        kind = key.rsplit("/", 1)[-1]
-        size = len(sample.payload)
-        info = sample.source_info
-        source = None if info is None else str(info.source_id)
-        self._emit(kind, key, size if size > self.max_bytes else sample.payload.to_bytes(), source)
-
-    def _on_vss(self, sample: Any) -> None:
-        """O(1) like `_on_sample`; the value is checked when printed (the bus is untrusted)."""
-        size = len(sample.payload)
-        data = size if size > VSS_MAX_BYTES else sample.payload.to_bytes()
-        self._emit("vss", str(sample.key_expr), data)
-
-    def _on_alive(self, sample: Any) -> None:
-        alive = sample.kind == self._sample_kind_put
-        self._alive_seen = True
-        self._emit("alive", str(sample.key_expr), json.dumps({"alive": alive}).encode())
-
-    def _on_miss(self, miss: Any) -> None:
-        self._emit("missed", self.keys.alert, int(miss.nb), str(miss.source))
-
-    def follow(self, timeout_s: float | None, stop: Any, endpoints: str) -> int:
-        from zenoh.ext import HistoryConfig, RecoveryConfig, declare_advanced_subscriber
-
-        session, keys = self.session, self.keys
-        # Liveliness first: a running daemon's `joined` is printed before its cached alerts.
-        self.entities.append(
-            session.liveliness().declare_subscriber(keys.alive, self._on_alive, history=True)
-        )
-        alive_deadline = time.monotonic() + ALIVE_HISTORY_S
-        while not self._alive_seen and time.monotonic() < alive_deadline and not stop.is_set():
-            time.sleep(0.02)
-        alerts = declare_advanced_subscriber(
-            session,
-            keys.alert,
-            self._on_sample,
-            history=HistoryConfig(detect_late_publishers=True, max_samples=self.history),
-            recovery=RecoveryConfig(heartbeat=True),  # type: ignore[call-arg]  # stub: both required
-        )
-        self.entities.append(alerts)
-        self.entities.append(alerts.sample_miss_listener(self._on_miss))
-        self.entities.append(session.declare_subscriber(keys.state, self._on_sample))
-        if not self.args.no_yaw:
-            self.entities.append(session.declare_subscriber(keys.yaw, self._on_sample))
-        if self.vss_prefix is not None:
-            from roadgaze.transport import vss_key
-
-            self.entities.append(
-                session.declare_subscriber(vss_key("Vehicle.**", self.vss_prefix), self._on_vss)
-            )
-        deadline = None if timeout_s is None else time.monotonic() + timeout_s
+    def follow(self, timeout_s: float | None, stop: Any, endpoints: str, plan: Any) -> int:
+        """Print until `timeout_s`, a stop or `--count`; the totals; the exit status."""
+        consumer, count = self.consumer, self.args.count
         printed = 0
-        while not stop.is_set() and (self.args.count is None or printed < self.args.count):
-            printed += self._release_left(time.monotonic())
-            wait_s = 0.2 if deadline is None else min(0.2, deadline - time.monotonic())
-            if self._left:
-                wait_s = min(wait_s, 0.05)
-            if wait_s <= 0:
+        for event in consumer.events(timeout_s, stop.is_set):
+            printed += self.handle(event)
+            if count is not None and printed >= count:
                 break
-            try:
-                kind, key, data, source = self.received.get(timeout=wait_s)
-            except queue.Empty:
-                continue
-            printed += self._print(kind, key, data, source)
-        printed += self._release_left(math.inf)
-        for line in self.book.unmatched_misses():
-            _say(line)
-        _say(self.book.totals(self.dropped))
+        for event in consumer.finish():
+            printed += self.handle(event)
+        _say(consumer.book.totals(consumer.dropped))
         if printed == 0 and timeout_s is not None and not stop.is_set():
-            if not self.ever_connected:
+            if not consumer.ever_connected:
                 _say(
                     f"connected to nothing ({endpoints}) in {timeout_s:g} s: "
-                    f"{unreachable_hint(self.plan)}"
+                    f"{unreachable_hint(plan)}"
                 )
             else:
                 _say(
-                    f"received nothing on {self.keys.prefix}/* in {timeout_s:g} s: is a daemon "
-                    "publishing for this vehicle?"
+                    f"received nothing on {consumer.keys.prefix}/* in {timeout_s:g} s: is a "
+                    "daemon publishing for this vehicle?"
                 )
             return 1
         return 0
 
-    def _print(self, kind: str, key: str, data: bytes | int, source: str | None) -> int:
-        from roadgaze.transport import PayloadError, printable
+    def handle(self, event: Any) -> int:
+        """Print one event; how many messages were printed on stdout (0 or 1)."""
+        from roadgaze.transport import consumer_events as events
+        from roadgaze.transport import printable
 
-        if kind == "vss":
-            return self._print_vss(key, data)
-        vehicle = vehicle_of(key, self.prefix_template)
-        if kind == "missed":
-            self.book.on_zenoh_miss(str(source), int(data))
-            return 0
-        if isinstance(data, int):
-            self.book.rejected += 1
-            self.warn(f"{kind} on {printable(key, 80)}: {data} bytes, limit {self.max_bytes}")
-            return 0
-        if kind == "alive":
-            payload: dict[str, Any] = json.loads(data)
-            self.book.on_alive(vehicle, bool(payload["alive"]))
-            if not payload["alive"]:  # printed after the vehicle's final state, if it comes
-                self._left[vehicle] = (time.monotonic() + LEFT_HOLD_S, key, payload)
+        match event:
+            case events.AlertReceived():
+                second = event.describe_second()
+                if second is not None:
+                    _say(second)
+                extra = {} if event.suspicious is None else {"suspicious": event.suspicious}
+                if event.late:
+                    extra["late"] = "it arrives after later ones (reported missed before)"
+                self.show("alert", event.key, event.vehicle_id, event.alert, extra)
+            case events.MessageReceived():
+                self.show(event.kind, event.key, event.vehicle_id, event.payload)
+            case events.PublisherJoined() | events.PublisherGone():
+                joined = isinstance(event, events.PublisherJoined)
+                self.show("alive", event.key, event.vehicle_id, {"alive": joined})
+            case events.VssReceived():
+                if self.args.json:
+                    print(json.dumps({"type": "vss", "key": event.key, "value": event.value}))
+                else:
+                    print(format_vss(event.key, event.value))
+                sys.stdout.flush()
+            case events.AlertsMissed() | events.AlertRefused() | events.SecondPublisher():
+                _say(event.describe())
                 return 0
-            self._left.pop(vehicle, None)
-        else:
-            try:
-                checked = self.checker.check(kind, key, data, source)
-            except PayloadError as exc:
-                self.book.rejected += 1
-                self.warn(f"{kind} on {printable(key, 80)}: {printable(str(exc))}")
+            case events.DuplicateAlert():
+                reason = f"duplicate or out of order: seq {event.seq}, expected {event.expected}"
+                self.warn(f"alert on {printable(event.key, 80)}: {reason}")
                 return 0
-            payload = checked.payload
-            if kind == "alert" and not self._own_alert(checked, vehicle, source):
+            case events.MessageRejected():
+                self.warn(f"{event.kind} on {printable(event.key, 80)}: {printable(event.reason)}")
                 return 0
-        self._show(kind, key, vehicle, payload)
-        if kind == "state" and vehicle in self._left:
-            return 1 + self._release_left(math.inf, vehicle)
+            case events.LinkUp():
+                log.info("roadgaze listen: connected to %s %s", event.whatami, event.remote)
+                return 0
+            case events.LinkLost():
+                log.warning(
+                    "roadgaze listen: %s %s gone; waiting for it to come back",
+                    event.whatami,
+                    event.remote,
+                )
+                return 0
+            case _:
+                return 0
         return 1
 
-    def _own_alert(self, checked: Any, vehicle: str, source: str | None) -> bool:
-        """False (after saying why) for an alert of another publisher; reports a gap before it."""
-        payload = checked.payload
-        seq = payload["seq"]
-        foreign = self.book.foreign_source(vehicle, source)
-        if foreign is not None:
-            self.book.foreign += 1
-            _say(
-                f"SUSPICIOUS alert #{seq} {payload['kind']} {payload['level']} of {vehicle} from "
-                f"{foreign}: not printed (another process publishes this vehicle's alerts; see "
-                "docs/security.md)"
-            )
-            return False
-        gap = self.book.gap(vehicle, str(source), seq, checked.missing_before, checked.first)
-        if gap is not None:
-            _say(gap)
-        self.book.printed += 1
-        return True
-
-    def _release_left(self, now: float, only: str | None = None) -> int:
-        """Print the held `alive ... left` lines whose wait is over (or `only`'s); count them."""
-        due = [
-            vehicle
-            for vehicle, (deadline, _, _) in self._left.items()
-            if (only is None or vehicle == only) and deadline <= now
-        ]
-        for vehicle in due:
-            _, key, payload = self._left.pop(vehicle)
-            self._show("alive", key, vehicle, payload)
-        return len(due)
-
-    def _print_vss(self, key: str, data: bytes | int) -> int:
-        from roadgaze.transport import PayloadError, parse_vss_text, printable
-
-        try:
-            if isinstance(data, int):
-                raise PayloadError(f"{data} bytes, limit {VSS_MAX_BYTES}")
-            value = parse_vss_text(key, data, self.vss_prefix or "")
-        except PayloadError as exc:
-            self.warn(f"vss on {printable(key, 80)}: {printable(str(exc))}")
-            return 0
-        if self.args.json:
-            print(json.dumps({"type": "vss", "key": key, "value": value}), flush=True)
-        else:
-            print(format_vss(key, value), flush=True)
-        return 1
-
-    def _show(self, kind: str, key: str, vehicle: str, payload: dict[str, Any]) -> None:
+    def show(
+        self,
+        kind: str,
+        key: str,
+        vehicle: str,
+        payload: dict[str, Any],
+        extra: dict[str, Any] | None = None,
+    ) -> None:
+        """One message on stdout: readable, or a JSON object with --json; `extra` (a flag) is
+        added to the object, or to the end of the line in brackets."""
         if self.args.json:
             record = {"type": kind, "key": key, "vehicle_id": vehicle, "payload": payload}
-            print(json.dumps(record), flush=True)
-        else:
-            print(format_pretty(kind, vehicle, payload, ""), flush=True)
-
-    def query_state(self, timeout_s: float) -> int:
-        """Ask every state queryable (no consolidation: a second answerer is seen) and print."""
-        from roadgaze.commands.listen_query import query_state
-
-        return query_state(self, timeout_s)
-
-    def close(self) -> None:
-        for entity in reversed(self.entities):
-            try:
-                entity.undeclare()
-            except Exception as exc:
-                log.debug("undeclare failed: %s", exc)
+            print(json.dumps(record | (extra or {})), flush=True)
+            return
+        line = format_pretty(kind, vehicle, payload, "")
+        if extra:
+            line += " [" + "; ".join(f"{name.upper()}: {text}" for name, text in extra.items())
+            line += "]"
+        print(line, flush=True)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import sys
-import time
 from typing import Any
 
 
@@ -11,42 +10,27 @@ def _say(text: str) -> None:
     print(f"roadgaze listen: {text}", file=sys.stderr, flush=True)
 
 
-def query_state(listener: Any, timeout_s: float) -> int:
-    """Ask every state queryable of `listener`'s keys (no consolidation: a second answerer is
-    seen), print the answers and return the exit status: 0 all running, 3 degraded or
+def query_state(printer: Any, timeout_s: float) -> int:
+    """Ask every state queryable of the printer's consumer (no consolidation: a second answerer
+    is seen), print the answers and return the exit status: 0 all running, 3 degraded or
     suspicious, 1 no answer."""
-    import zenoh
+    from roadgaze.transport import printable
+    from roadgaze.transport.state_query import query_states
 
-    from roadgaze.transport import PayloadError, printable
-
-    deadline = time.monotonic() + timeout_s
-    answers: dict[str, list[str]] = {}
-    rejected = 0
-    while not answers and time.monotonic() < deadline:
-        # Right after opening, the routes to the queryable may not be known yet: ask again.
-        wait_s = max(0.05, min(1.0, deadline - time.monotonic()))
-        replies = listener.session.get(
-            listener.keys.state,
-            timeout=wait_s,
-            target=zenoh.QueryTarget.ALL,
-            consolidation=zenoh.ConsolidationMode.NONE,
-        )
-        for reply in replies:
-            if reply.ok is None:
-                continue
-            key = str(reply.ok.key_expr)
-            try:
-                checked = listener.checker.check("state", key, reply.ok.payload.to_bytes())
-            except PayloadError as exc:
-                _say(f"state answer on {printable(key, 80)} rejected: {printable(str(exc))}")
-                rejected += 1
-                continue
-            answers.setdefault(checked.vehicle_id, []).append(str(checked.payload["status"]))
-            listener._show("state", key, checked.vehicle_id, checked.payload)
+    consumer = printer.consumer
+    answers, rejected = query_states(consumer.session, consumer.keys, consumer.checker, timeout_s)
+    while (event := consumer.next_event(0.0)) is not None:  # the link, as `follow` logs it
+        printer.handle(event)
+    statuses: dict[str, list[str]] = {}
+    for key, why in rejected:
+        _say(f"state answer on {printable(key, 80)} rejected: {printable(why)}")
+    for checked in answers:
+        statuses.setdefault(checked.vehicle_id, []).append(str(checked.payload["status"]))
+        printer.show("state", checked.key, checked.vehicle_id, checked.payload)
     if not answers:
-        _say(f"no answer from {listener.keys.state}")
+        _say(f"no answer from {consumer.keys.state}")
         return 1
-    twice = {vehicle: n for vehicle, statuses in answers.items() if (n := len(statuses)) > 1}
+    twice = {vehicle: n for vehicle, found in statuses.items() if (n := len(found)) > 1}
     if twice:
         _say(
             f"suspicious: several answers for one vehicle {twice}: another process answers "
@@ -55,9 +39,9 @@ def query_state(listener: Any, timeout_s: float) -> int:
         return 3
     if rejected:
         _say(
-            f"suspicious: {rejected} answer(s) rejected beside the valid one: another process "
-            "answers on the state key (see docs/security.md)"
+            f"suspicious: {len(rejected)} answer(s) rejected beside the valid one: another "
+            "process answers on the state key (see docs/security.md)"
         )
         return 3
-    statuses = [status for found in answers.values() for status in found]
-    return 0 if all(status == "running" for status in statuses) else 3
+    every = [status for found in statuses.values() for status in found]
+    return 0 if all(status == "running" for status in every) else 3

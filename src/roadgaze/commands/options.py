@@ -11,6 +11,19 @@ from pydantic import ValidationError
 
 from roadgaze.config import Config, ZenohConfig, load_config, parse_overrides
 from roadgaze.errors import ConfigError
+from roadgaze.outputs.paths import PLOT_SUFFIXES, check_output_paths
+
+__all__ = [
+    "PLOT_SUFFIXES",
+    "add_speed_options",
+    "add_zenoh_options",
+    "check_output_paths",
+    "check_seconds",
+    "common_options",
+    "config_from_args",
+    "with_zenoh_args",
+    "zenoh_config_from_args",
+]
 
 
 def common_options() -> argparse.ArgumentParser:
@@ -134,47 +147,3 @@ def check_seconds(option: str, value: float | None) -> None:
     takes 'nan' and 'inf' as floats, and a loop waiting for NaN seconds never ends."""
     if value is not None and not (math.isfinite(value) and value > 0):
         raise ConfigError(f"{option} must be a finite number of seconds > 0, found {value}")
-
-
-PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".webp", ".tif", ".tiff")
-"""File types matplotlib writes (a plot is saved at the end: a bad name must fail at the start)."""
-
-
-def _same_file(first: Path, second: Path) -> bool:
-    try:
-        return first.resolve() == second.resolve() or (
-            first.exists() and second.exists() and first.samefile(second)
-        )
-    except OSError:
-        return False
-
-
-def check_output_paths(
-    inputs: dict[str, str | Path],
-    outputs: dict[str, str | Path | None],
-    suffixes: dict[str, tuple[str, ...]] | None = None,
-) -> None:
-    """Refuse, before anything is written, an output path that is an input (it would destroy
-    it), two outputs on one path (they would mix formats) and an output whose file type its
-    writer cannot write. Keys are the option names used in the message; '-' is stdout."""
-    given = {name: Path(path) for name, path in outputs.items() if path not in (None, "-")}
-    for name, path in given.items():
-        allowed = (suffixes or {}).get(name)
-        if allowed and path.suffix.lower() not in allowed:
-            raise ConfigError(
-                f"{name} {path}: cannot write a {path.suffix or 'suffix-less'} file; "
-                f"use {', '.join(allowed)}"
-            )
-        for input_name, input_path in inputs.items():
-            if _same_file(path, Path(input_path)):
-                raise ConfigError(
-                    f"{name} {path} is the input ({input_name}): it would be overwritten; "
-                    "choose another output path"
-                )
-    names = list(given)
-    for index, name in enumerate(names):
-        for other in names[index + 1 :]:
-            if _same_file(given[name], given[other]):
-                raise ConfigError(
-                    f"{name} and {other} are the same file {given[name]}; give each its own path"
-                )

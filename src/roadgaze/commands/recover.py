@@ -21,7 +21,9 @@ def register(subparsers: Any) -> None:
         help="make an MCAP recording cut short (kill -9, power loss) whole and indexed",
         description="Read an MCAP recording in order up to its last complete chunk and write "
         "every message read into a new, indexed file (NAME.mcap.part -> NAME.mcap, else "
-        "NAME.recovered.mcap). Lost: the chunk being written when the recording stopped (at "
+        "NAME.recovered.mcap). An existing file is never overwritten: when that name is taken "
+        "the first free NAME-1.mcap, NAME-2.mcap, ... is written (and said); an --out that "
+        "exists is refused (exit 2). Lost: the chunk being written when the recording stopped (at "
         "most record.flush_s of data). `run --record` does this itself for the segments a "
         "killed run left in its folder. Needs roadgaze[foxglove].",
     )
@@ -41,7 +43,11 @@ def run(args: argparse.Namespace, config: Config) -> int:
         raise SourceError(f"MCAP file {args.source} not found")
     out = args.out if args.out is not None else recovered_name(args.source)
     check_output_paths({"FILE": args.source}, {"--out": out}, {"--out": (".mcap",)})
-    recovery = recover_mcap(args.source, out)
+    recovery = recover_mcap(
+        args.source, out, exact=args.out is not None, max_chunk_mib=config.record.max_chunk_mib
+    )
     log.info("recover %s: %s", args.source, recovery.describe())
-    log_written(out)
+    if recovery.path != out:
+        log.warning("%s exists (another file, never overwritten): wrote %s", out, recovery.path)
+    log_written(recovery.path)
     return 0

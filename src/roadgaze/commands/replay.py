@@ -1,8 +1,9 @@
 """`roadgaze replay VIDEO [--out frames.jsonl]`: the pipeline over a recording, a record per frame.
 
-`add_arguments` declares the options, `build_sinks` turns them into pipeline sinks, `run` opens
-source and detector, runs the loop and reports. Every sink reads the frame record, so a new
-output is one option and one sink, in any order.
+`add_arguments` declares the options, `run_options` turns them into the run's options, and
+`run` has `roadgaze.pipeline.build_run` build the run (source, detector, bus, writers), runs the
+loop and reports. Every sink reads the frame record, so a new output is one option and one sink
+(in `roadgaze.pipeline.sinks`), in any order.
 """
 
 from __future__ import annotations
@@ -11,25 +12,21 @@ import argparse
 import logging
 import math
 import sys
-from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from roadgaze.commands.options import (
-    PLOT_SUFFIXES,
     add_speed_options,
     add_zenoh_options,
-    check_output_paths,
     common_options,
     with_zenoh_args,
 )
 from roadgaze.config import Config
 from roadgaze.logs import log_written
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.types import Alert, Frame, FrameRecord
 
 if TYPE_CHECKING:
-    from roadgaze.capture import SourceInfo
-    from roadgaze.pipeline import RunSummary, Sink, SpeedSource, VehicleSpeed
+    from roadgaze.pipeline import RunOptions, RunSummary
 
 log = logging.getLogger("roadgaze.replay")
 
@@ -121,6 +118,9 @@ class ReplayStats:
             self.smoothed_max_deg = max(self.smoothed_max_deg, sample.yaw_deg)
         self.alerts += len(record.alerts)
 
+    def on_alert(self, alert: Alert) -> None:
+        self.alerts += 1
+
     def close(self) -> None:
         return None
 
@@ -132,32 +132,6 @@ class ReplayStats:
         if self.smoothed_min_deg <= self.smoothed_max_deg:
             text += f", smoothed {self.smoothed_min_deg:+.1f}..{self.smoothed_max_deg:+.1f} deg"
         return text
-
-
-def build_sinks(
-    args: argparse.Namespace, info: SourceInfo, stack: ExitStack, config: Config
-) -> list[Sink]:
-    """The writer sinks the options ask for, each registered on `stack` to be closed at the end."""
-    from roadgaze.outputs import AnnotatedVideoWriter, CsvWriter, JsonlWriter, ProgressBar, YawPlot
-
-    sinks: list[Sink] = []
-    to_stdout = args.out in (None, "-")
-    sinks.append(stack.enter_context(JsonlWriter(sys.stdout if to_stdout else Path(args.out))))
-    if args.csv is not None:
-        sinks.append(stack.enter_context(CsvWriter(args.csv)))
-    if args.plot is not None:
-        title = Path(info.name).name
-        sinks.append(stack.enter_context(YawPlot(args.plot, title, monitor=config.monitor)))
-    if args.annotate is not None:
-        writer = AnnotatedVideoWriter(args.annotate, info.fps or 30.0, monitor=config.monitor)
-        sinks.append(stack.enter_context(writer))
-    records_on_terminal = to_stdout and sys.stdout.isatty()
-    if not args.no_progress and not records_on_terminal:  # the records show the progress there
-        total = info.frame_count
-        if args.max_frames is not None and total is not None:
-            total = min(total, args.max_frames)
-        sinks.append(stack.enter_context(ProgressBar(total, description="replay")))
-    return sinks
 
 
 def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) -> None:
@@ -183,60 +157,51 @@ def report(args: argparse.Namespace, summary: RunSummary, stats: ReplayStats) ->
             log_written(value)
 
 
+def run_options(args: argparse.Namespace) -> RunOptions:
+    """The run the options ask for (`roadgaze.pipeline.build_run`)."""
+    from roadgaze.pipeline import RunOptions
+
+    to_stdout = args.out in (None, "-")
+    records_on_terminal = to_stdout and sys.stdout.isatty()
+    # On a terminal the records show the progress.
+    with_bar = not args.no_progress and not records_on_terminal
+    return RunOptions(
+        args.source,
+        command="replay",
+        publish=args.publish,
+        speed_track=args.speed_track,
+        speed_kmh=args.speed_kmh,
+        track_beside=True,
+        records="-" if to_stdout else args.out,
+        csv=args.csv,
+        plot=args.plot,
+        annotate=args.annotate,
+        mcap=args.mcap,
+        progress="replay" if with_bar else None,
+        max_frames=args.max_frames,
+        realtime=args.realtime,
+        inputs={"--config": args.config},
+    )
+
+
 def run(args: argparse.Namespace, config: Config) -> int:
-    from roadgaze.capture import open_source
-    from roadgaze.capture.speed_track import recorded_speed
-    from roadgaze.daemon import bus_outputs
     from roadgaze.errors import ConfigError
-    from roadgaze.outputs.video import FOURCC_BY_SUFFIX
-    from roadgaze.pipeline import Pipeline, create_detector
+    from roadgaze.pipeline import EXIT_UNDELIVERED, build_run
     from roadgaze.service.signals import sigterm_as_interrupt
 
     if args.max_frames is not None and args.max_frames < 1:
         raise ConfigError(f"--max-frames must be at least 1, found {args.max_frames}")
-    outputs = {"--out": args.out, "--csv": args.csv, "--plot": args.plot}
-    speed_input = {} if args.speed_track is None else {"--speed-track": args.speed_track}
-    check_output_paths(
-        {"VIDEO": args.source, **speed_input},
-        {**outputs, "--annotate": args.annotate, "--mcap": args.mcap},
-        {"--plot": PLOT_SUFFIXES, "--annotate": tuple(FOURCC_BY_SUFFIX), "--mcap": (".mcap",)},
-    )
     if args.mcap is not None:
         from roadgaze.outputs.foxglove import require_foxglove
 
         require_foxglove("--mcap")
     config = with_zenoh_args(config, args)
-    speed_choice = recorded_speed(
-        args.source, args.speed_track, args.speed_kmh, config.zenoh.speed_timeout_s
-    )
     stats = ReplayStats()
-    with ExitStack() as stack:
-        stack.enter_context(sigterm_as_interrupt())
-        source = stack.enter_context(open_source(args.source, config))
-        detector = create_detector(config)
-        stack.callback(detector.close)
-        bus = stack.enter_context(bus_outputs(config, args.source, args.publish, log_name=log.name))
-        sinks = [stats, *bus.sinks, *build_sinks(args, source.info, stack, config)]
-        if args.mcap is not None:
-            from roadgaze.outputs.foxglove.open import replay_recorder
-
-            flat_out = not args.realtime and not source.info.live
-            recorder = replay_recorder(
-                config, args.source, args.mcap, bus.health.state_json, block_on_images=flat_out
-            )
-            sinks.append(stack.enter_context(recorder))
-        speed: VehicleSpeed | SpeedSource = bus.speed
-        origin = "the bus" if args.publish else "nowhere: unknown, taken as moving"
-        if speed_choice.speed is not None:  # a recorded drive's own speed wins over the bus
-            speed, origin = speed_choice.speed, speed_choice.origin
-        log.info("replay %s: vehicle speed from %s", args.source, origin)
-        pipeline = Pipeline.from_config(config, detector, speed=speed)
-        summary = pipeline.run(source, sinks, realtime=args.realtime, max_frames=args.max_frames)
+    with sigterm_as_interrupt(), build_run(config, run_options(args), sinks=(stats,)) as replay:
+        summary = replay.run(realtime=args.realtime, max_frames=args.max_frames)
     fill_offline(args, config)
     report(args, summary, stats)
-    if bus.undelivered():
-        from roadgaze.daemon import EXIT_UNDELIVERED
-
+    if replay.undelivered():
         return EXIT_UNDELIVERED  # the warning naming them was logged when the link closed
     return 0
 

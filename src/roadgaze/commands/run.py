@@ -59,7 +59,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     # Handlers before the heavy imports: as PID 1 of a container, a SIGTERM arriving while
     # they load would otherwise be ignored (PID 1 has no default action).
     with signal_handlers(stop):
-        from roadgaze.daemon import run_daemon
+        from roadgaze.service.daemon import run_daemon
 
         return run_daemon(
             with_zenoh_args(config, args),

@@ -6,17 +6,19 @@ source is in its table (`roadgaze.monitor.protocols`) and in docs/monitor.md.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
 from pydantic import Field, model_validator
 
 from roadgaze.config.section import Section
 
-if TYPE_CHECKING:
-    from roadgaze.pose.mounting import CameraMounting
-
 AREA1_ZONE_NAMES = ("far_left", "far_right", "roof")
 """The zones of ADDW's distraction area 1 (roadgaze.monitor.zones): reserved names."""
+ROOF_PITCH_MAX_DEG = 30.0
+"""The highest `roof_pitch_deg`. The regulation places area 1 at the vehicle's roof, not at an
+angle; roadgaze's angle is the head's pitch relative to the neutral, which reads about half of a
+look up: a look 60 deg up at Pointing'04's markers reads +30.0 on average (docs/pose.md). A roof
+set higher would lie beyond that look, and a look at the roof would never reach area 1."""
 ProtocolName = Literal["addw", "euroncap", "both"]
 MountingName = Literal["front", "steering_column", "a_pillar", "centre_console"]
 
@@ -46,7 +48,7 @@ class ProtocolSettings(Section):
     on-road sample)."""
 
     camera_mounting: MountingName = "front"
-    """Where the camera sits (roadgaze.pose.mounting): head pose and gaze are mapped into the
+    """Where the camera sits (roadgaze.mounting): head pose and gaze are mapped into the
     driver's frame before zones, the neutral and alerts."""
     cabin: Literal["lhd", "rhd"] = "lhd"
     """Left- or right-hand drive: mirrors the mounting preset and the default zones."""
@@ -58,8 +60,9 @@ class ProtocolSettings(Section):
     distraction_yaw_deg: float = Field(default=55.0, gt=0, le=55)
     """ADDW area 1: beyond +-this yaw from the driver's forward direction is always distraction
     (at most 55: the regulation's planes)."""
-    roof_pitch_deg: float = Field(default=20.0, gt=0, le=90)
-    """ADDW area 1, the roof: above this pitch (relative to the neutral) is always distraction."""
+    roof_pitch_deg: float = Field(default=20.0, gt=0, le=ROOF_PITCH_MAX_DEG)
+    """ADDW area 1, the roof: above this pitch (relative to the neutral) is always distraction
+    (at most ROOF_PITCH_MAX_DEG: higher, no look at a roof would reach it)."""
 
     frame_failure_s: float = Field(default=2.0, gt=0)
     """Blocked, black or saturated frames this long while moving: `temporary_failure`."""
@@ -92,15 +95,3 @@ class ProtocolSettings(Section):
                 f"addw_distraction_low_s ({self.addw_distraction_low_s:g}): faster warns sooner"
             )
         return self
-
-    def mounting(self) -> CameraMounting:
-        """The camera mounting: the preset in this cabin, with any explicit angles."""
-        from roadgaze.pose.mounting import mounting_for
-
-        return mounting_for(
-            self.camera_mounting,
-            self.cabin,
-            self.camera_yaw_deg,
-            self.camera_pitch_deg,
-            self.camera_roll_deg,
-        )

@@ -56,6 +56,11 @@ class RecordConfig(Section):
     camera_topic: str | None = None
     """The channel an MCAP drive's camera frames are read from (`replay`, `batch`): None = the
     only image channel, else `/camera/image`."""
+    max_chunk_mib: float = Field(default=32.0, gt=0, le=4096)
+    """Reading an MCAP recording (`replay`, `batch`, `bench`, `recover`): a chunk that declares
+    more than this uncompressed is refused before it is decompressed, so this setting, not the
+    file, sets the memory a chunk takes. A chunk holds at least one message: an uncompressed 4K
+    RGB frame (3840 x 2160 x 3 bytes, 24 MiB) fits the default."""
 
     @model_validator(mode="after")
     def _disk_holds_two_segments(self) -> Self:

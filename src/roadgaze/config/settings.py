@@ -13,7 +13,7 @@ import os
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal, Self
+from typing import Any, Literal, Self
 
 from pydantic import Field, ValidationError, field_validator, model_validator
 
@@ -25,10 +25,6 @@ from roadgaze.config.section import Section as _Section
 from roadgaze.config.zenoh import ZenohConfig
 from roadgaze.config.zones import ZoneConfig, check_area1, default_zones, mirrored_zones
 from roadgaze.errors import ConfigError
-
-if TYPE_CHECKING:
-    from roadgaze.monitor.zones import ZoneMap
-    from roadgaze.pose.geometry import FaceModelConstants
 
 ENV_PREFIX = "ROADGAZE__"
 
@@ -71,12 +67,6 @@ class GeometryConfig(_Section):
         if not 0.0 <= value[0] < value[1]:
             raise ValueError(f"needs 0 <= start < end, found {list(value)}")
         return value
-
-    def face_constants(self) -> FaceModelConstants:
-        """The constants as the yaw models take them."""
-        from roadgaze.pose.geometry import FaceModelConstants
-
-        return FaceModelConstants(self.alpha, self.beta, self.gamma_c, self.gamma_b)
 
 
 class PoseConfig(_Section):
@@ -123,7 +113,7 @@ class LandmarksConfig(_Section):
 
 
 class CaptureConfig(_Section):
-    """Camera settings (ignored for files)."""
+    """Camera settings (ignored for files), and the size of a speed track read."""
 
     width: int = Field(default=640, gt=0)
     height: int = Field(default=480, gt=0)
@@ -131,6 +121,8 @@ class CaptureConfig(_Section):
     fourcc: str = Field(default="MJPG", min_length=4, max_length=4)
     reconnect_initial_s: float = Field(default=0.5, gt=0)
     reconnect_max_s: float = Field(default=10.0, gt=0)
+    speed_track_max_rows: int = Field(default=2_000_000, gt=0)
+    """Most rows of a speed track read (roadgaze.speed: 16 bytes each); a longer one is refused."""
 
 
 class SmoothingConfig(_Section):
@@ -244,21 +236,6 @@ class MonitorConfig(EyeMonitorSettings, ProtocolSettings):
         if self.cabin == "rhd" and self.zones == default_zones():
             return mirrored_zones(self.zones)
         return self.zones
-
-    def zone_map(self) -> ZoneMap:
-        """The zones as the monitor classifies with them, the road first."""
-        from roadgaze.monitor.zones import ROAD, Zone, ZoneMap
-
-        road_yaw = self.road_half_width_deg - self.hysteresis_deg
-        road = Zone(ROAD, -road_yaw, road_yaw, *self.road_pitch_deg)
-        others = tuple(Zone(z.name, *z.yaw_deg, *z.pitch_deg) for z in self.effective_zones())
-        return ZoneMap(
-            zones=(road, *others),
-            hysteresis_deg=self.hysteresis_deg,
-            driving_related=frozenset(self.driving_related_zones),
-            distraction_yaw_deg=self.distraction_yaw_deg,
-            roof_pitch_deg=self.roof_pitch_deg,
-        )
 
     @model_validator(mode="after")
     def _thresholds_agree(self) -> Self:

@@ -4,17 +4,14 @@ area 1. Pure (pydantic only); the classifier is `roadgaze.monitor.zones`."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from pydantic import Field, field_validator
 
 from roadgaze.config.protocol import AREA1_ZONE_NAMES
 from roadgaze.config.section import Section
 
-if TYPE_CHECKING:
-    from roadgaze.config.settings import MonitorConfig
-
-__all__ = ["ZoneConfig", "check_area1", "default_zones", "mirrored_zones"]
+__all__ = ["ZoneConfig", "ZoneSettings", "check_area1", "default_zones", "mirrored_zones"]
 
 
 class ZoneConfig(Section):
@@ -58,7 +55,25 @@ def mirrored_zones(zones: list[ZoneConfig]) -> list[ZoneConfig]:
     ]
 
 
-def check_area1(monitor: MonitorConfig) -> None:
+class ZoneSettings(Protocol):
+    """What the zone checks read of `[monitor]` (`MonitorConfig`, which builds on this module)."""
+
+    @property
+    def zones(self) -> list[ZoneConfig]: ...
+    @property
+    def driving_related_zones(self) -> list[str]: ...
+    @property
+    def distraction_yaw_deg(self) -> float: ...
+    @property
+    def roof_pitch_deg(self) -> float: ...
+    @property
+    def road_pitch_deg(self) -> tuple[float, float]: ...
+    @property
+    def road_half_width_deg(self) -> float: ...
+    def effective_zones(self) -> list[ZoneConfig]: ...
+
+
+def check_area1(monitor: ZoneSettings) -> None:
     """Raise ValueError when a zone takes an area-1 name, a driving-related zone reaches into
     area 1, or the road does."""
     names = [zone.name for zone in monitor.zones]

@@ -1,10 +1,15 @@
 """A scenario as a recorded drive: its frames, `NAME.speed.csv`, `NAME.truth.csv` (`NAME.mkv`).
 
 The head pose and eyes of the scenario (driver's frame) go through the camera mounting
-(`roadgaze.pose.mounting.head_to_camera`) and are rendered as that camera sees the face; sensor
-noise goes on every frame (a held pose is not a frozen camera), sunglasses over the eyes when the
-scenario wears them. A covered lens is a dark flat frame, no face the cabin without the driver,
-frozen frames the last frame again, byte for byte. `RenderedSource` hands the frames to the loop
+(`roadgaze.mounting.head_to_camera`) and are rendered as that camera sees the face (a head
+pose of 0, 0 in the camera's frame faces the lens: the photo's own downward look,
+`HeadFrame.facing_pitch_deg`, is nodded away), dressed
+in what the scenario's `conditions` name (`roadgaze.synth.outfit`: glasses, a mask, a beard, a
+cap, ...), the jaw moving with speech when it is `talking`, a hand on the wheel where the camera
+sees it (`hand_at_12`); sensor noise goes on every frame (a held pose is not a frozen camera),
+or at `night` the infrared picture with its own noise (`roadgaze.synth.effects.night`). A covered
+lens is a dark flat frame, no face the cabin without the driver, frozen frames the last frame
+again, byte for byte. `RenderedSource` hands the frames to the loop
 as a video file would, rendered in the loop's decode thread (so rendering overlaps MediaPipe);
 with a clip path it also writes them losslessly (FFV1), so `roadgaze replay NAME.mkv` shows the
 same drive. The speed track (`roadgaze.capture.speed_track`) holds the scenario's speed every
@@ -22,14 +27,22 @@ import numpy as np
 
 from roadgaze.capture.base import SourceBase, SourceInfo, SourceStatus
 from roadgaze.conformance.model import CameraState, Scenario
-from roadgaze.pose.mounting import Cabin, head_to_camera, mounting_for
+from roadgaze.mounting import Cabin, head_to_camera, mounting_for
 from roadgaze.synth.clip import write_truth_csv
-from roadgaze.synth.effects import NoiseBank, covered_frame, sunglasses
+from roadgaze.synth.effects import NoiseBank, covered_frame, night
 from roadgaze.synth.eyes import EyeRenderer, EyeState
+from roadgaze.synth.head import HeadFrame
+from roadgaze.synth.layers import Layer
+from roadgaze.synth.mouth import speech_track
+from roadgaze.synth.occluders import hand_layer
+from roadgaze.synth.outfit import WORN, Outfit, check_conditions
 from roadgaze.synth.renderer import ImageBGR
 from roadgaze.synth.timeline import Keyframe, Timeline
 from roadgaze.types import FloatArray, Frame
 
+MOUTH_STEP = 0.02
+"""The jaw's opening is rendered in steps of this fraction of a yawn (0.8 mm on a 14 cm face), so
+a held pose with a talking mouth reuses its frames."""
 SPEED_PERIOD_S = 0.5
 """A speed sample every half second (a CAN speed signal comes at 10-50 Hz; the track holds)."""
 CLIP_SUFFIX = ".mkv"
@@ -70,38 +83,73 @@ class ScenarioRenderer:
         self.renderer = renderer
         self.fps = fps
         self.cabin = cabin
+        self.facing_pitch_deg = HeadFrame.of(renderer).facing_pitch_deg
+        """Added to every rendered pitch: the photo's face looks this far below its camera."""
+        self._outfits: dict[tuple[str, ...], Outfit] = {}
+        self._hands: dict[str, Layer | None] = {}
+
+    def outfit(self, conditions: tuple[str, ...]) -> Outfit:
+        """The face dressed in the worn ones of `conditions` (built once per combination)."""
+        worn = tuple(name for name in WORN if name in conditions)
+        if worn not in self._outfits:
+            self._outfits[worn] = Outfit(self.renderer, worn)
+        return self._outfits[worn]
+
+    def _hand(self, preset: str) -> Layer | None:
+        """The hand on the wheel as the camera at `preset` sees it (built once per camera)."""
+        if preset not in self._hands:
+            road_yaw, road_pitch, _ = head_to_camera(mounting_for(preset, self.cabin), 0.0, 0.0)
+            rest = (road_yaw, road_pitch + self.facing_pitch_deg)
+            self._hands[preset] = hand_layer(self.renderer, preset, self.cabin, rest)
+        return self._hands[preset]
 
     def _face(
-        self, scenario: Scenario, row: FloatArray, cache: dict[tuple[float, ...], ImageBGR]
+        self,
+        scenario: Scenario,
+        row: FloatArray,
+        mouth_open: float,
+        cache: dict[tuple[float, ...], ImageBGR],
     ) -> ImageBGR:
         mounting = mounting_for(scenario.mounting, self.cabin)
-        yaw, pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
-        key = tuple(round(float(v), 4) for v in (yaw, pitch, *row[3:6]))
+        yaw, camera_pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
+        pitch = camera_pitch + self.facing_pitch_deg
+        key = tuple(round(float(v), 4) for v in (yaw, pitch, *row[3:6], mouth_open))
         if key not in cache:
+            outfit = self.outfit(scenario.conditions)
             state = EyeState.both(float(row[3]), float(row[4]), float(row[5]))
-            frame = self.renderer.render_eyes(yaw, pitch, state)
-            if scenario.sunglasses:
-                frame = sunglasses(frame, self.renderer, yaw, pitch)
+            frame = outfit.render(yaw, pitch, state, mouth_open)
+            hand = self._hand(scenario.mounting) if "hand_at_12" in scenario.conditions else None
+            frame = frame if hand is None else hand.over(frame)
             cache[key] = frame
         return cache[key]
 
     def frames(self, scenario: Scenario) -> Iterator[ImageBGR]:
-        """Every frame of the scenario, in order (rendered as they are asked for)."""
+        """Every frame of the scenario, in order (rendered as they are asked for). Raises
+        ConfigError for a condition that does not exist."""
+        check_conditions(scenario.conditions)
         truth = timeline_of(scenario).eye_truth(self.fps)
         states = camera_states(scenario, truth[:, 0])
-        rng = np.random.default_rng(zlib.crc32(scenario.name.encode()))
+        seed = zlib.crc32(scenario.name.encode())
+        rng = np.random.default_rng(seed)
         noise = NoiseBank(self.renderer.size, rng)
+        at_night = "night" in scenario.conditions
+        mouth = np.zeros(len(truth))
+        if "talking" in scenario.conditions:
+            mouth = np.round(speech_track(truth[:, 0], seed) / MOUTH_STEP) * MOUTH_STEP
         cache: dict[tuple[float, ...], ImageBGR] = {}
         last: ImageBGR | None = None
-        for row, state in zip(truth, states, strict=True):
+        for row, state, opening in zip(truth, states, mouth, strict=True):
             if state == "frozen" and last is not None:
                 frame = last
             elif state == "covered":
                 frame = covered_frame(self.renderer.size, rng)
-            elif state == "no_face":
-                frame = noise(self.renderer.background)
             else:
-                frame = noise(self._face(scenario, row, cache))
+                seen = (
+                    self.renderer.background
+                    if state == "no_face"
+                    else self._face(scenario, row, float(opening), cache)
+                )
+                frame = night(seen, rng) if at_night else noise(seen)
             last = frame
             yield frame
 

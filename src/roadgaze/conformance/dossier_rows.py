@@ -151,9 +151,24 @@ ROWS: tuple[SheetRow, ...] = (*_LONG_ROWS, *_SHORT_ROWS, *_PHONE_ROWS, *_NON_TRA
 """Every row of the sheet that takes a prediction, in sheet order."""
 
 
-def dark_sunglasses(scenario: Scenario) -> Scenario:
-    """The scenario with the driver in dark sunglasses from the first frame."""
-    return replace(scenario, name=f"{scenario.name}__dark_sunglasses", sunglasses=True)
+Variant = Callable[[Scenario], Scenario]
+
+
+def under(condition: str) -> Variant:
+    """A function rendering a scenario under `condition` (a name of
+    `roadgaze.synth.outfit.CONDITIONS`) from its first frame, run as `NAME__condition`."""
+
+    def variant(scenario: Scenario) -> Scenario:
+        conditions = (*scenario.conditions, condition)
+        return replace(scenario, name=f"{scenario.name}__{condition}", conditions=conditions)
+
+    variant.__name__ = variant.__qualname__ = condition
+    variant.__doc__ = f"The scenario rendered under `{condition}` from its first frame."
+    return variant
+
+
+dark_sunglasses = under("dark_sunglasses")
+"""The scenario with the driver in dark sunglasses from the first frame."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -166,22 +181,22 @@ class NoiseVariable:
     element: str
     mandatory: bool
     """The calculator scores Driver Monitoring 0 unless this one is Functional."""
-    variant: Callable[[Scenario], Scenario] | None = None
+    variant: Variant | None = None
 
 
 NOISE_VARIABLES: tuple[NoiseVariable, ...] = (
-    NoiseVariable(2, "Daytime - Night-time", True),
-    NoiseVariable(3, "Clear sunglasses", True),
+    NoiseVariable(2, "Daytime - Night-time", True, under("night")),
+    NoiseVariable(3, "Clear sunglasses", True, under("clear_sunglasses")),
     NoiseVariable(4, "Dark sunglasses", False, dark_sunglasses),
-    NoiseVariable(5, "Short facial hair", True),
-    NoiseVariable(6, "Long facial hair", True),
-    NoiseVariable(7, "Hand on wheel at 12 o'clock position", False),
-    NoiseVariable(8, "Face-mask", True),
-    NoiseVariable(9, "Cap", False),
-    NoiseVariable(10, "Hat", False),
-    NoiseVariable(11, "Long head hair fringe obscuring eyes", False),
-    NoiseVariable(12, "Thick eyelash makeup", False),
-    NoiseVariable(13, "Talking", False),
+    NoiseVariable(5, "Short facial hair", True, under("stubble")),
+    NoiseVariable(6, "Long facial hair", True, under("beard")),
+    NoiseVariable(7, "Hand on wheel at 12 o'clock position", False, under("hand_at_12")),
+    NoiseVariable(8, "Face-mask", True, under("mask")),
+    NoiseVariable(9, "Cap", False, under("cap")),
+    NoiseVariable(10, "Hat", False, under("hat")),
+    NoiseVariable(11, "Long head hair fringe obscuring eyes", False, under("fringe")),
+    NoiseVariable(12, "Thick eyelash makeup", False, under("eyelash_makeup")),
+    NoiseVariable(13, "Talking", False, under("talking")),
 )
 """The sheet's rows 2-13 ("Talking" is named in column B, the others in column C)."""
 

@@ -35,8 +35,7 @@ def source_of(rule: Rule) -> str:
 
 def applies(config: MonitorConfig, rule: Rule) -> bool:
     """Whether the configured protocols ask for `rule` (roadgaze's own rules always apply)."""
-    protocol = rule.key.split(".", 1)[0]
-    return protocol not in ("addw", "euroncap") or uses(config, protocol)
+    return rule.protocol not in ("addw", "euroncap") or uses(config, rule.protocol)
 
 
 def trigger_at(config: MonitorConfig, speed_kmh: float | None) -> Trigger | None:

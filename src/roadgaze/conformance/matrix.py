@@ -13,6 +13,7 @@ from roadgaze.config import MonitorConfig
 from roadgaze.conformance import expect
 from roadgaze.conformance.model import Requirement, Scenario, Segment
 from roadgaze.monitor.protocols import addw
+from roadgaze.monitor.zones import ZoneMap
 
 AHEAD_S = 3.0
 """Looking at the road first: the neutral's running mean settles within a second or two."""
@@ -52,7 +53,7 @@ def back() -> Segment:
 def zone_target(config: MonitorConfig, name: str) -> tuple[float, float]:
     """The centre of zone `name`'s rectangle (yaw within ADDW's area, pitch within what the
     renderer shows), relative to the neutral, in degrees."""
-    zone = next(z for z in config.zone_map().zones if z.name == name)
+    zone = next(z for z in ZoneMap.from_config(config).zones if z.name == name)
     limit = config.distraction_yaw_deg - 5.0
     yaw_min, yaw_max = max(zone.yaw_min_deg, -limit), min(zone.yaw_max_deg, limit)
     pitch_min = max(zone.pitch_min_deg, PITCH_LIMITS_DEG[0])
@@ -74,11 +75,13 @@ def _glance(
     duration_s: float = LOOK_S,
     fast: bool = False,
     mounting: str = "front",
-    sunglasses: bool = False,
+    conditions: tuple[str, ...] = (),
 ) -> Scenario:
-    """A look at `target` for `duration_s` at `speed_kmh` that must warn in its window."""
+    """A look at `target` for `duration_s` at `speed_kmh` that must warn in its window (under
+    dark sunglasses, within ADDW's non-nominal allowance)."""
+    hidden_eyes = "dark_sunglasses" in conditions
     requirement = expect.distraction(
-        config, speed_kmh, f"{name}.warns", what, non_nominal=sunglasses
+        config, speed_kmh, f"{name}.warns", what, non_nominal=hidden_eyes
     )
     segments = (ahead(), look(target, duration_s), back())
     return Scenario(
@@ -88,7 +91,7 @@ def _glance(
         speed_kmh,
         (requirement,),
         mounting=mounting,
-        sunglasses=sunglasses,
+        conditions=conditions,
         fast=fast,
     )
 
@@ -161,7 +164,7 @@ def distraction_scenarios(config: MonitorConfig) -> list[Scenario]:
             f"4 s lap glance in sunglasses at {fast_kmh_text}",
             lap,
             FAST_KMH,
-            sunglasses=True,
+            conditions=("dark_sunglasses",),
         ),
     ]
     slow = "8 s lap glance at 10 km/h"

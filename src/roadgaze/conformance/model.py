@@ -65,9 +65,16 @@ class Scenario:
     """The vehicle speed written to the scenario's speed track; None: no track (unknown)."""
     requirements: tuple[Requirement, ...]
     mounting: str = "front"
-    sunglasses: bool = False
+    conditions: tuple[str, ...] = ()
+    """What the driver wears and the camera meets, from the first frame: names of
+    `roadgaze.synth.outfit.CONDITIONS` (`dark_sunglasses`, `night`, `mask`, `talking`, ...)."""
     fast: bool = False
     """Part of the `--fast` subset (the test suite's)."""
+
+    @property
+    def sunglasses(self) -> bool:
+        """The driver wears dark sunglasses."""
+        return "dark_sunglasses" in self.conditions
 
     @property
     def duration_s(self) -> float:

@@ -2,7 +2,7 @@
 
 Each drive goes through the same loop as `roadgaze replay` (`Pipeline`, MediaPipe in VIDEO mode,
 a fresh landmarker per drive) with the vehicle speed read from the drive's speed track the way
-`replay` and `batch` read it (`roadgaze.capture.speed_track.recorded_speed`), and the service
+`replay` and `batch` read it (the run built by `roadgaze.pipeline.build_run`), and the service
 told the scenario's camera mounting. Every alert is kept; each requirement is judged on them.
 """
 
@@ -11,7 +11,6 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Sequence
-from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,7 +18,7 @@ from roadgaze.capture import FrameSource
 from roadgaze.config import Config
 from roadgaze.conformance.clips import CLIP_SUFFIX, RenderedSource, ScenarioRenderer
 from roadgaze.conformance.model import Outcome, Scenario, judge
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.types import Alert, Frame, FrameRecord
 
 log = logging.getLogger(__name__)
 
@@ -35,7 +34,10 @@ class AlertLog:
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         for alert in record.alerts:
-            self.alerts.append((alert.kind.value, alert.level.value, alert.t_s))
+            self.on_alert(alert)
+
+    def on_alert(self, alert: Alert) -> None:
+        self.alerts.append((alert.kind.value, alert.level.value, alert.t_s))
 
     def close(self) -> None:
         return None
@@ -50,19 +52,12 @@ def scenario_config(config: Config, scenario: Scenario) -> Config:
 
 def replay_drive(source: FrameSource, track: Path | None, config: Config) -> Alerts:
     """Every alert the service raises on `source`, the speed from `track` (None: unknown)."""
-    from roadgaze.capture.speed_track import recorded_speed
-    from roadgaze.pipeline import Pipeline, create_detector, no_speed
+    from roadgaze.pipeline import RunOptions, build_run
 
-    speed = recorded_speed(None, track, hold_s=config.zenoh.speed_timeout_s).speed
     sink = AlertLog()
-    with ExitStack() as stack:
-        stack.enter_context(source)
-        detector = create_detector(config)
-        stack.callback(detector.close)
-        pipeline = Pipeline.from_config(
-            config, detector, speed=speed if speed is not None else no_speed
-        )
-        pipeline.run(source, [sink])
+    options = RunOptions(source.info.name, command="conformance", speed_track=track, quiet=True)
+    with build_run(config, options, source=source, sinks=(sink,)) as run:
+        run.run()
     return sink.alerts
 
 

@@ -1,7 +1,7 @@
 """Doctor: what a user needs to know before filing a bug, one check per line (OK, WARN or FAIL)."""
 
 from roadgaze.doctor.report import Check, Status, format_checks, run_checks, worst
-from roadgaze.doctor.service import (
+from roadgaze.doctor.resources import (
     check_cameras,
     check_model,
     check_zenoh,

@@ -47,7 +47,7 @@ def worst(checks: Sequence[Check]) -> Status:
 def run_checks(config: Config) -> list[Check]:
     """Every check, in report order. A check that crashes is reported as a FAIL line."""
     from roadgaze.doctor.hands import check_hands
-    from roadgaze.doctor.service import check_cameras, check_model, check_zenoh
+    from roadgaze.doctor.resources import check_cameras, check_model, check_zenoh
     from roadgaze.doctor.software import check_egl, check_opencv, check_versions
 
     groups: list[tuple[str, Callable[[], list[Check]]]] = [

@@ -53,6 +53,9 @@ class ConditionRow:
     eyes_closed: int
     level_faces: int
     level_road: int
+    faces_by_subject: tuple[tuple[str, int, int], ...] = ()
+    """(subject, faces found, images) per subject, in the order of their first image, when the
+    ground truth names subjects."""
 
     @property
     def faces_rate(self) -> float:
@@ -72,6 +75,10 @@ class ConditionRow:
             "eyes_not_judged": self.eye_faces - self.eyes_open - self.eyes_closed,
             "level_faces": self.level_faces,
             "level_road": self.level_road,
+            "subjects": [
+                {"subject": subject, "faces": faces, "images": images}
+                for subject, faces, images in self.faces_by_subject
+            ],
         }
 
 
@@ -177,7 +184,14 @@ def score_condition(
         for t, e in with_tilt
         if abs(t.yaw_deg) <= LEVEL_YAW_DEG and abs(t.pitch_deg or 0.0) <= LEVEL_TILT_DEG
     ]
+    by_subject: dict[str, list[int]] = {}
+    for truth, estimate in zip(truths, estimates, strict=True):
+        if truth.subject is not None:
+            counts = by_subject.setdefault(truth.subject, [0, 0])
+            counts[0] += estimate.face
+            counts[1] += 1
     return ConditionRow(
+        faces_by_subject=tuple((name, found, n) for name, (found, n) in by_subject.items()),
         condition=condition,
         images=len(truths),
         faces=len(found),
@@ -224,4 +238,20 @@ def format_condition_table(rows: Sequence[ConditionRow]) -> str:
             f"| {_percent(not_judged, row.eye_faces)} "
             f"| {_percent(row.level_road, row.level_faces)} ({row.level_faces}) |"
         )
+    return "\n".join(lines)
+
+
+def format_subject_table(rows: Sequence[ConditionRow]) -> str | None:
+    """Faces found % per subject (a column each) and condition (a row each), as Markdown; None
+    when the ground truth names no subjects."""
+    subjects = [subject for subject, _, _ in rows[0].faces_by_subject] if rows else []
+    if not subjects:
+        return None
+    lines = [
+        "| faces found % by subject | " + " | ".join(subjects) + " |",
+        "|---|" + "---|" * len(subjects),
+    ]
+    for row in rows:
+        cells = [_percent(found, images) for _, found, images in row.faces_by_subject]
+        lines.append(f"| {row.condition} | " + " | ".join(cells) + " |")
     return "\n".join(lines)

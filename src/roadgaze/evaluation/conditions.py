@@ -244,55 +244,109 @@ def face_mask(
     return _cover(image, region, mask_level, texture_std, rng)
 
 
-Transform = Callable[[Image, np.random.Generator, Landmarks], Image]
+Transform = Callable[..., Image]
+"""`transform(image, rng, landmarks, **parameters)`: a condition with its keyword parameters."""
 
 
 def _plain(function: Callable[..., Image]) -> Transform:
-    def transform(image: Image, rng: np.random.Generator, landmarks: Landmarks) -> Image:
-        return function(image, rng)
+    def transform(
+        image: Image, rng: np.random.Generator, landmarks: Landmarks, **parameters: Any
+    ) -> Image:
+        return function(image, rng, **parameters)
 
     transform.__doc__ = function.__doc__
     return transform
 
 
-CONDITIONS: dict[str, Transform] = {
-    "ir_grey": _plain(ir_grey),
-    "dark": _plain(dark_cabin),
-    "glare": _plain(bright_glare),
-    "motion_blur": _plain(motion_blur),
-    "jpeg": _plain(jpeg_compression),
+_FUNCTIONS: dict[str, Callable[..., Image]] = {
+    "ir_grey": ir_grey,
+    "dark": dark_cabin,
+    "glare": bright_glare,
+    "motion_blur": motion_blur,
+    "jpeg": jpeg_compression,
     "low_res": low_resolution,
     "sunglasses": sunglasses,
     "mask": face_mask,
 }
-"""The suite's conditions by name, in the table's order (`clean` is the image as it is)."""
 NEEDS_LANDMARKS = frozenset({"low_res", "sunglasses", "mask"})
 """Conditions drawn from the clean image's face."""
+CONDITIONS: dict[str, Transform] = {
+    name: function if name in NEEDS_LANDMARKS else _plain(function)
+    for name, function in _FUNCTIONS.items()
+}
+"""The suite's conditions by name, in the table's order (`clean` is the image as it is)."""
+
+
+def condition_parameters(name: str) -> dict[str, float | int]:
+    """The keyword parameters of condition `name` and their defaults (the suite's values)."""
+    import inspect
+
+    signature = inspect.signature(_FUNCTIONS[name])
+    return {
+        parameter.name: parameter.default
+        for parameter in signature.parameters.values()
+        if parameter.kind is inspect.Parameter.KEYWORD_ONLY
+    }
+
+
+def parse_condition(text: str) -> tuple[str, dict[str, float | int]]:
+    """A condition's name and the parameters it sets: `ir_grey` or, with other values than the
+    suite's, `ir_grey:noise_std=9,contrast=0.3` (a parameter whose default is a whole number
+    takes a whole number).
+
+    Raises ValueError naming what is known for an unknown condition or parameter or a bad value.
+    """
+    name, _, settings = text.partition(":")
+    if name not in CONDITIONS:
+        known = ", ".join([CLEAN, *CONDITIONS])
+        raise ValueError(f"unknown condition {name!r}; expected one of {known}, all")
+    defaults = condition_parameters(name)
+    parameters: dict[str, float | int] = {}
+    for setting in filter(None, settings.split(",")):
+        key, equals, value = setting.partition("=")
+        if key not in defaults or not equals:
+            raise ValueError(
+                f"condition {name}: expected PARAMETER=VALUE with a parameter among "
+                f"{', '.join(defaults)}, found {setting!r}"
+            )
+        try:
+            number = float(value)
+            whole = isinstance(defaults[key], int)
+            if whole and not number.is_integer():
+                raise ValueError
+            parameters[key] = int(number) if whole else number
+        except ValueError:
+            kind = "a whole number" if isinstance(defaults[key], int) else "a number"
+            raise ValueError(f"condition {name}: {key} must be {kind}, found {value!r}") from None
+    return name, parameters
 
 
 def condition_names(requested: list[str]) -> list[str]:
-    """The conditions to run, in the suite's order, `clean` first: `all` means every one.
+    """The conditions to run, in the suite's order, `clean` first: `all` means every one; a
+    condition with parameters (`parse_condition`) after the plain one.
 
-    Raises ValueError naming the known conditions for an unknown name.
+    Raises ValueError (`parse_condition`'s) for an unknown condition or parameter.
     """
     known = [CLEAN, *CONDITIONS]
     chosen: set[str] = {CLEAN}
-    for name in requested:
-        if name == "all":
+    for text in requested:
+        if text == "all":
             chosen.update(known)
-        elif name in known:
-            chosen.add(name)
-        else:
-            raise ValueError(f"unknown condition {name!r}; expected one of {', '.join(known)}, all")
-    return [name for name in known if name in chosen]
+        elif text != CLEAN:
+            parse_condition(text)
+            chosen.add(text)
+    return sorted(chosen, key=lambda text: (known.index(text.partition(":")[0]), text))
 
 
 def apply_condition(
     name: str, image: Image, landmarks: Landmarks, file: str, seed: int = SEED
 ) -> Image:
-    """`image` under condition `name` (`clean`: unchanged), with the generator seeded from
-    `seed`, the condition and `file` (a stable name of the image)."""
+    """`image` under condition `name` (`clean`: unchanged; parameters as `parse_condition`
+    reads them), with the generator seeded from `seed`, the condition's plain name and `file`
+    (a stable name of the image): the same noise whatever the parameters."""
     if name == CLEAN:
         return image
-    key = zlib.crc32(f"{name}\0{file}".encode())
-    return CONDITIONS[name](image, np.random.default_rng([seed, key]), landmarks)
+    condition, parameters = parse_condition(name)
+    key = zlib.crc32(f"{condition}\0{file}".encode())
+    generator = np.random.default_rng([seed, key])
+    return CONDITIONS[condition](image, generator, landmarks, **parameters)

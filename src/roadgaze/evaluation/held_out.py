@@ -26,7 +26,7 @@ from pathlib import Path
 
 from roadgaze.config import Config
 from roadgaze.errors import DatasetError
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.types import Alert, Frame, FrameRecord
 
 __all__ = [
     "CASES",
@@ -133,9 +133,12 @@ class _Collect:
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         del frame
         for alert in record.alerts:
-            self.alerts.append((alert.t_s, alert.kind.value, alert.reason))
+            self.on_alert(alert)
         self.zones.append(record.verdict.zone if record.verdict is not None else None)
         self.yaws.append(record.sample.yaw_deg)
+
+    def on_alert(self, alert: Alert) -> None:
+        self.alerts.append((alert.t_s, alert.kind.value, alert.reason))
 
     def close(self) -> None:
         pass
@@ -185,21 +188,16 @@ def run_case(
     folder: Path | None = None,
 ) -> CaseResult:
     """One case through the in-process pipeline with a constant speed (`--speed-kmh`)."""
-    from roadgaze.capture import open_source
-    from roadgaze.pipeline import ConstantSpeed, Pipeline, create_detector
+    from roadgaze.pipeline import RunOptions, build_run
 
     config = config if config is not None else Config()
     with tempfile.TemporaryDirectory(dir=folder) as tmp:
         clip = Path(tmp) / f"s{stills.subject}_{case.name}.avi"
         look_t_s = write_clip(clip, stills, case)
         collect = _Collect()
-        detector = create_detector(config)
-        try:
-            with open_source(str(clip), config) as source:
-                pipeline = Pipeline.from_config(config, detector, ConstantSpeed(case.speed_kmh))
-                pipeline.run(source, [collect])
-        finally:
-            detector.close()
+        options = RunOptions(str(clip), command="held-out", speed_kmh=case.speed_kmh, quiet=True)
+        with build_run(config, options, sinks=(collect,)) as run:
+            run.run()
     return result_of(stills, case, look_t_s, collect.alerts, collect.zones, collect.yaws)
 
 

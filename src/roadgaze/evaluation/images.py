@@ -154,7 +154,7 @@ class StillPose:
 
     @classmethod
     def from_config(cls, config: Config) -> StillPose:
-        return cls(PoseEstimator.from_config(config), config.monitor.zone_map(), config)
+        return cls(PoseEstimator.from_config(config), ZoneMap.from_config(config.monitor), config)
 
     def estimate(self, face: FaceFeatures) -> tuple[float | None, float | None, str | None]:
         """Yaw, pitch and zone of one face as a first sample with neutral 0."""
@@ -184,7 +184,7 @@ def estimate_from_detection(
     if driver is None:
         return ImageEstimate(file=name, face=False, n_faces=len(detection.faces))
     if still is None:
-        still = StillPose(PoseEstimator(constants=constants), Config().monitor.zone_map())
+        still = StillPose(PoseEstimator(constants=constants), ZoneMap.from_config(Config().monitor))
     service_yaw, pitch, zone = still.estimate(driver)
     return ImageEstimate(
         eyes=still_eyes(driver, service_yaw, pitch, still.config),

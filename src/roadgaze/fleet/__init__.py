@@ -9,7 +9,8 @@ from roadgaze.fleet.drives import (
     discover_drives,
     read_manifest,
 )
-from roadgaze.fleet.engines import LocalEngine, RayEngine, available_cores
+from roadgaze.fleet.engines import LocalEngine, RayEngine
+from roadgaze.fleet.executors import LocalExecutor, RayExecutor, available_cores
 from roadgaze.fleet.recorder import DriveRecorder
 from roadgaze.fleet.report import render_report
 from roadgaze.fleet.results import ALERT_KINDS, DriveResult
@@ -29,7 +30,9 @@ __all__ = [
     "DriveTask",
     "GroupStats",
     "LocalEngine",
+    "LocalExecutor",
     "RayEngine",
+    "RayExecutor",
     "alerts_schema",
     "available_cores",
     "by_driver",

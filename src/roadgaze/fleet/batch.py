@@ -1,4 +1,5 @@
-"""A batch: every drive through an engine, resumable, with the fleet summary and report at the end.
+"""A batch: every drive through an executor, resumable, with the fleet summary and report at the
+end.
 
 Output folder layout: `frames/<drive_id>.parquet`, `alerts/<drive_id>.parquet`,
 `summary.parquet`, `report.html` and `batch.log` (the workers' own output). One batch at a time
@@ -20,7 +21,7 @@ from typing import Literal
 from roadgaze.config import Config
 from roadgaze.errors import ConfigError
 from roadgaze.fleet.drives import Drive
-from roadgaze.fleet.engines import RAY_TIMEOUT_S, Engine, LocalEngine, RayEngine
+from roadgaze.fleet.executors import RAY_TIMEOUT_S, Executor, LocalExecutor, RayExecutor
 from roadgaze.fleet.report import render_report
 from roadgaze.fleet.results import DriveResult
 from roadgaze.fleet.summary import BatchOutcome, summary_table
@@ -108,16 +109,16 @@ def pinned_model(config: Config) -> Config:
     return config.model_copy(update={"model": config.model.model_copy(update={"path": path})})
 
 
-def make_engine(options: BatchOptions) -> Engine:
+def make_executor(options: BatchOptions) -> Executor:
     if options.engine == "ray":
-        return RayEngine(
+        return RayExecutor(
             options.out_dir / LOG_NAME,
             options.ray_address,
             options.workers,
             options.retries,
             options.ray_timeout_s,
         )
-    return LocalEngine(options.out_dir / LOG_NAME, options.workers, options.retries)
+    return LocalExecutor(options.out_dir / LOG_NAME, options.workers, options.retries)
 
 
 class BatchProgress:
@@ -181,14 +182,14 @@ def run_batch(drives: Sequence[Drive], config: Config, options: BatchOptions) ->
                     results[task.drive.drive_id] = done
         to_run = [task for task in tasks if task.drive.drive_id not in results]
         stop = StopFlag()
-        engine_start = time.perf_counter()
-        with make_engine(options) as engine:
-            startup_s = time.perf_counter() - engine_start
+        executor_start = time.perf_counter()
+        with make_executor(options) as executor:
+            startup_s = time.perf_counter() - executor_start
             run_start = time.perf_counter()
             progress = BatchProgress(len(to_run), options.progress)
             try:
                 with signal_handlers(stop, log_name="roadgaze.batch", hard_exit=False):
-                    for result in engine.run(to_run, stop):
+                    for result in executor.run(to_run, stop):
                         results[result.drive_id] = result
                         progress.update(result)
                         if stop.is_set():
@@ -199,12 +200,12 @@ def run_batch(drives: Sequence[Drive], config: Config, options: BatchOptions) ->
         outcome = BatchOutcome(
             results=tuple(results.get(d.drive_id) or DriveResult.of(d, "pending") for d in drives),
             engine=options.engine,
-            workers=engine.workers,
+            workers=executor.workers,
             wall_s=wall_s,
             startup_s=startup_s,
             interrupted=stop.is_set(),
-            worker_deaths=getattr(engine, "worker_deaths", 0),
-            retries=getattr(engine, "retried", 0),
+            worker_deaths=getattr(executor, "worker_deaths", 0),
+            retries=getattr(executor, "retried", 0),
         )
         write_summary(out_dir, outcome)
     return outcome

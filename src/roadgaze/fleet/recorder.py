@@ -13,7 +13,7 @@ from roadgaze.fleet.drives import Drive
 from roadgaze.fleet.results import ALERT_KINDS, DriveResult
 from roadgaze.fleet.tables import AtomicParquetWriter
 from roadgaze.outputs.records import OFFLINE_FIELDS, alert_fields, record_fields, rounded
-from roadgaze.types import AlertKind, AlertLevel, Frame, FrameRecord, Gaze
+from roadgaze.types import Alert, AlertKind, AlertLevel, Frame, FrameRecord, Gaze
 
 
 @dataclass(slots=True)
@@ -53,11 +53,18 @@ class DriveRecorder:
         self.longest_off_road_s = max(self.longest_off_road_s, verdict.off_road_s)
         self.neutral_yaw_deg = verdict.neutral_yaw_deg
         for alert in record.alerts:
-            self.alerts.append({"frame": sample.frame, **alert_fields(alert)})
-            self.critical += alert.level is AlertLevel.CRITICAL
-            if alert.kind.value in self.counts and alert.kind not in self._active:
-                self.counts[alert.kind.value] += 1
+            self._note(alert, sample.frame)
         self._active = verdict.active
+
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop: a row of the alerts table with no frame."""
+        self._note(alert, None)
+
+    def _note(self, alert: Alert, frame: int | None) -> None:
+        self.alerts.append({"frame": frame, **alert_fields(alert)})
+        self.critical += alert.level is AlertLevel.CRITICAL
+        if alert.kind.value in self.counts and alert.kind not in self._active:
+            self.counts[alert.kind.value] += 1
 
     def close(self) -> None:
         return None

@@ -58,7 +58,7 @@ def speed_fingerprint(task: DriveTask) -> dict[str, Any]:
     """What the drive's vehicle speed depends on: the constant, or the track file's size and
     modification time (its SHA-256 with `content_hash`); never raises (a bad track fails the
     drive when it runs)."""
-    from roadgaze.capture.speed_track import track_beside
+    from roadgaze.speed import track_beside
 
     if task.speed_kmh is not None:
         return {"kmh": task.speed_kmh}
@@ -198,8 +198,7 @@ def process_drive(task: DriveTask) -> DriveResult:
 
 def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> DriveResult:
     from roadgaze.capture import open_file
-    from roadgaze.capture.speed_track import recorded_speed
-    from roadgaze.pipeline import Pipeline, create_detector, no_speed
+    from roadgaze.pipeline import RunOptions, build_run
 
     drive, config = task.drive, task.config
     frames_path, alerts_path = output_paths(task.out_dir, drive.drive_id)
@@ -209,20 +208,22 @@ def _run_drive(task: DriveTask, fingerprint: dict[str, Any], started: float) -> 
         "vehicle_id": drive.vehicle_id,
         "start_time": drive.start_time,
     }
-    hold_s = config.zenoh.speed_timeout_s
-    speed = recorded_speed(drive.path, drive.speed_track, task.speed_kmh, hold_s).speed
+    options = RunOptions(
+        str(drive.path),
+        command="batch",
+        speed_track=drive.speed_track,
+        speed_kmh=task.speed_kmh,
+        track_beside=True,
+        quiet=True,
+    )
     with ExitStack() as stack:
-        source = stack.enter_context(open_file(drive.path, config))
-        detector = create_detector(config)
-        stack.callback(detector.close)
-        startup_s = time.perf_counter() - started
         frames = stack.enter_context(AtomicParquetWriter(frames_path, frames_schema(), constant))
         alerts = stack.enter_context(AtomicParquetWriter(alerts_path, alerts_schema(), constant))
         recorder = DriveRecorder(frames, alerts)
-        pipeline = Pipeline.from_config(
-            config, detector, speed=speed if speed is not None else no_speed
-        )
-        summary = pipeline.run(source, [recorder], stop=_stop)
+        source = open_file(drive.path, config)
+        run = stack.enter_context(build_run(config, options, source=source, sinks=(recorder,)))
+        startup_s = time.perf_counter() - started
+        summary = run.run(stop=_stop)
         if _stop is not None and _stop.is_set():
             return DriveResult.of(drive, "interrupted", error="stopped before the end")
         if summary.frames == 0:

@@ -52,6 +52,13 @@ SMOOTHING_KERNEL_PX = 5
 fewer false closures than a 5x5 or 7x7 box (docs/conditions.md)."""
 GAMMA_RANGE = (0.35, 2.5)
 """The gamma of the curve is kept within this range."""
+STRONG_DIAMETER_PX = 9
+"""The `strong` smoothing: a bilateral filter over this many pixels across, ..."""
+STRONG_SPACE_SIGMA_PX = 3.0
+"""... weighting pixels by distance with this standard deviation ..."""
+STRONG_COLOUR_SIGMA = 2.0
+"""... and by the difference of their levels with this many times the measured noise: the
+noise is flattened, a face's edges (several noise levels high) are kept."""
 RETRY_STEP_S = 1e-4
 """In a stream, the second look at a frame is passed as taken this much later (the detector
 needs strictly increasing times)."""
@@ -149,19 +156,38 @@ def tone_curve(levels: FrameLevels) -> npt.NDArray[np.uint8]:
     return np.asarray(np.rint(255.0 * ramp**gamma), np.uint8)
 
 
-def enhance(image: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
-    """`image` as the detector should see it, in one grey channel (a dark frame's colour carries
-    little, and one channel costs a third): its luminance, smoothed by a `SMOOTHING_KERNEL_PX`
-    Gaussian when its noise is `NOISY_LEVELS` or more, through its tone curve (the levels and
-    the noise measured on the luminance)."""
+def _enhanced(
+    image: npt.NDArray[np.uint8], strong: bool = False
+) -> tuple[npt.NDArray[np.uint8], FrameLevels]:
+    """`enhance`, and the levels and noise of the frame's luminance."""
     import cv2
 
     grey = _luminance(image)
     levels = assess(grey, noise=True)  # on the luminance (the decision read a colour's green)
-    if levels.noise >= NOISY_LEVELS:
+    if levels.noise >= NOISY_LEVELS and strong:
+        sigma_colour = STRONG_COLOUR_SIGMA * levels.noise
+        grey = np.asarray(
+            cv2.bilateralFilter(grey, STRONG_DIAMETER_PX, sigma_colour, STRONG_SPACE_SIGMA_PX),
+            np.uint8,
+        )
+    elif levels.noise >= NOISY_LEVELS:
         size = (SMOOTHING_KERNEL_PX, SMOOTHING_KERNEL_PX)
         grey = np.asarray(cv2.GaussianBlur(grey, size, 0), np.uint8)
-    return np.asarray(cv2.LUT(grey, tone_curve(levels)), np.uint8)
+    return np.asarray(cv2.LUT(grey, tone_curve(levels)), np.uint8), levels
+
+
+def enhance(image: npt.NDArray[np.uint8], strong: bool = False) -> npt.NDArray[np.uint8]:
+    """`image` as the detector should see it, in one grey channel (a dark frame's colour carries
+    little, and one channel costs a third): its luminance, smoothed when its noise is
+    `NOISY_LEVELS` or more, through its tone curve (the levels and the noise measured on the
+    luminance). The smoothing is a `SMOOTHING_KERNEL_PX` Gaussian, or with `strong` an
+    edge-preserving bilateral filter (`STRONG_DIAMETER_PX`; about 30 times the Gaussian's CPU,
+    so only for a second look)."""
+    return _enhanced(image, strong)[0]
+
+
+Version = Literal["plain", "curve", "strong"]
+"""A frame's version for the detector: as it came, `enhance`d, or `enhance`d `strong`."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -169,11 +195,20 @@ class FrontEndPrepared:
     """A frame after the front end, prepared for the wrapped detector."""
 
     image: npt.NDArray[np.uint8]
-    """The frame as it came (a second look enhances it)."""
+    """The frame as it came (a further look makes another version of it)."""
     inner: Any
-    """What the wrapped detector's `prepare` made of the (maybe enhanced) frame."""
-    enhanced: bool
+    """What the wrapped detector's `prepare` made of the frame in `version`."""
+    version: Version
     enhance_ms: float
+    hard: bool = False
+    """Dark or flat (`FrameLevels.needs_curve`), in `auto` mode: the frame gets the further
+    looks of a hard frame."""
+    noisy: bool = False
+    """A hard frame's noise is `NOISY_LEVELS` or more (a `strong` look differs from `curve`)."""
+
+    @property
+    def enhanced(self) -> bool:
+        return self.version != "plain"
 
 
 @dataclass(frozen=True, slots=True)
@@ -182,11 +217,13 @@ class FrontEndInference:
 
     inner: Any
     enhanced: bool
-    """The faces were found in the enhanced frame."""
+    """The faces were found in an enhanced version of the frame."""
     prepare_ms: float
     """The front end's time in `prepare` (the decision and the curve)."""
     retry_ms: float = 0.0
-    """The curve of a held or second look in `infer` (not the second inference)."""
+    """The enhancement of a held or further look in `infer` (not the further inferences)."""
+    version: Version = "plain"
+    """The version the faces were found in (the first look's without a face)."""
 
     @property
     def faces(self) -> Any:
@@ -198,7 +235,7 @@ class FrontEndDetector(ClosesOnExit):
 
     It has the `prepare`/`infer`/`measure` steps the loop runs on its threads
     (`roadgaze.pipeline.steps`): the decision and the curve run in `prepare` (the decode thread
-    for a file), a second look in `infer`. A wrapped detector with only `detect` gets the front
+    for a file), further looks in `infer`. A wrapped detector with only `detect` gets the front
     end too. Closing it closes the wrapped detector.
     """
 
@@ -209,7 +246,8 @@ class FrontEndDetector(ClosesOnExit):
         self._infer = getattr(detector, "infer", None)
         self._measure = getattr(detector, "measure", None)
         self._steps = None not in (self._prepare, self._infer, self._measure)
-        self._hold_curve = False
+        self._retries = self._steps and "retry_rejected" in _parameters(self._infer)
+        self._hold: Version = "plain"
         self._hold_until_s = -math.inf
         self._retry_after_s = -math.inf
 
@@ -226,57 +264,79 @@ class FrontEndDetector(ClosesOnExit):
     def prepare(self, image: npt.NDArray[np.uint8]) -> FrontEndPrepared:
         """The frame, enhanced when the mode and the rule say so, prepared for the detector."""
         start = time.perf_counter()
-        enhanced = self.mode == "always" or (self.mode == "auto" and assess(image).needs_curve)
-        image_in = enhance(image) if enhanced else image
+        hard = self.mode == "auto" and assess(image).needs_curve
+        if hard or self.mode == "always":
+            image_in, levels = _enhanced(image)
+            version: Version = "curve"
+        else:
+            image_in, levels, version = image, None, "plain"
+        noisy = hard and levels is not None and levels.noise >= NOISY_LEVELS
         spent_ms = (time.perf_counter() - start) * 1e3
-        return FrontEndPrepared(image, self._inner_prepare(image_in), enhanced, spent_ms)
+        inner = self._inner_prepare(image_in)
+        return FrontEndPrepared(image, inner, version, spent_ms, hard, noisy)
 
-    def _run(self, inner: Any, t_s: float | None) -> Any:
+    def _run(self, inner: Any, t_s: float | None, retry_rejected: bool = False) -> Any:
+        if self._retries and self._infer is not None:
+            return self._infer(inner, t_s, retry_rejected=retry_rejected)
         if self._steps and self._infer is not None:
             return self._infer(inner, t_s)
         return self.detector.detect(inner, t_s)
 
-    def infer(self, prepared: FrontEndPrepared, t_s: float | None = None) -> FrontEndInference:
-        """The detector on the prepared frame. In `auto` mode, when it finds no face, once more
-        on the other version of the frame (enhanced if it was untouched, untouched if it was
-        enhanced; at `t_s + RETRY_STEP_S` in a stream).
+    @staticmethod
+    def looks(prepared: FrontEndPrepared) -> tuple[Version, ...]:
+        """The versions `auto` tries in turn until one has a face: a good frame as it came, then
+        enhanced; a hard one enhanced, then (when noisy) enhanced `strong`, then as it came."""
+        if not prepared.hard:
+            return ("plain", "curve")
+        return ("curve", "strong") if prepared.noisy else ("curve", "plain")
 
-        In a stream a second look that found the face makes the next `HOLD_S` seconds of frames
-        take the version that found it (no second inference each); one that found none waits
-        `RETRY_WAIT_S` before the next, so a stream without a face costs one extra inference a
-        second.
+    def infer(self, prepared: FrontEndPrepared, t_s: float | None = None) -> FrontEndInference:
+        """The detector on the prepared frame. In `auto` mode, when it finds no face, on the
+        frame's further versions in turn (`looks`; the n-th at `t_s + n * RETRY_STEP_S` in a
+        stream); on a hard frame the detector is also asked to look again at a face its landmark
+        model rejected (`retry_rejected`).
+
+        In a stream a further look that found the face makes the next `HOLD_S` seconds of frames
+        take its version first (no further inference each); when none found one, the next
+        further looks (and retries) wait `RETRY_WAIT_S`, so a stream without a face costs one
+        round of them a second.
         """
         if self.mode != "auto":
             return FrontEndInference(
                 self._run(prepared.inner, t_s), prepared.enhanced, prepared.enhance_ms
             )
-        enhanced, inner, retry_ms = prepared.enhanced, prepared.inner, 0.0
-        if t_s is not None and t_s < self._hold_until_s and self._hold_curve is not enhanced:
-            inner, retry_ms = self._other_version(prepared, enhanced)
-            enhanced = not enhanced
-        inference = self._run(inner, t_s)
-        if _has_faces(inference) or (t_s is not None and t_s < self._retry_after_s):
-            return FrontEndInference(inference, enhanced, prepared.enhance_ms, retry_ms)
-        other, other_ms = self._other_version(prepared, enhanced)
-        second = self._run(other, None if t_s is None else t_s + RETRY_STEP_S)
-        found = _has_faces(second)
-        if t_s is not None and found:
-            self._hold_curve, self._hold_until_s = not enhanced, t_s + HOLD_S
-        elif t_s is not None:
+        looks = self.looks(prepared)
+        if t_s is not None and t_s < self._hold_until_s and self._hold in looks:
+            looks = (self._hold, *(look for look in looks if look != self._hold))
+        waiting = t_s is not None and t_s < self._retry_after_s
+        first: Any = None
+        retry_ms = 0.0
+        for index, version in enumerate(looks[:1] if waiting else looks):
+            inner = prepared.inner
+            if version != prepared.version:
+                inner, spent_ms = self._version_of(prepared, version)
+                retry_ms += spent_ms
+            retry = prepared.hard and version != "plain" and not waiting
+            inference = self._run(inner, None if t_s is None else t_s + index * RETRY_STEP_S, retry)
+            if _has_faces(inference):
+                if index > 0 and t_s is not None:
+                    self._hold, self._hold_until_s = version, t_s + HOLD_S
+                return FrontEndInference(
+                    inference, version != "plain", prepared.enhance_ms, retry_ms, version
+                )
+            first = inference if first is None else first
+        if t_s is not None and not waiting:
             self._retry_after_s = t_s + RETRY_WAIT_S
         return FrontEndInference(
-            second if found else inference,
-            enhanced is not found,
-            prepared.enhance_ms,
-            retry_ms + other_ms,
+            first, looks[0] != "plain", prepared.enhance_ms, retry_ms, looks[0]
         )
 
-    def _other_version(self, prepared: FrontEndPrepared, enhanced: bool) -> tuple[Any, float]:
-        """The frame prepared in the version it is not in, and the curve's time (ms)."""
-        if enhanced:
+    def _version_of(self, prepared: FrontEndPrepared, version: Version) -> tuple[Any, float]:
+        """The frame prepared in `version`, and the enhancement's time (ms)."""
+        if version == "plain":
             return self._inner_prepare(prepared.image), 0.0
         start = time.perf_counter()
-        image = enhance(prepared.image)
+        image = enhance(prepared.image, strong=version == "strong")
         return self._inner_prepare(image), (time.perf_counter() - start) * 1e3
 
     def measure(self, inference: FrontEndInference) -> Detection:
@@ -291,6 +351,16 @@ class FrontEndDetector(ClosesOnExit):
 
     def close(self) -> None:
         self.detector.close()
+
+
+def _parameters(function: Any) -> frozenset[str]:
+    """The names of a callable's parameters (none when it has no signature)."""
+    import inspect
+
+    try:
+        return frozenset(inspect.signature(function).parameters)
+    except (TypeError, ValueError):
+        return frozenset()
 
 
 def with_front_end(detector: LandmarkDetector, mode: EnhanceMode) -> LandmarkDetector:

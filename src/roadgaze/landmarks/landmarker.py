@@ -131,6 +131,8 @@ class Landmarker(ClosesOnExit):
         self._side = rule_side(landmarks_config.driver, seat_side)
         self._tracker = DriverTracker(landmarks_config.driver, seat_side)
         self._recorded: RecordedDriver | None = None
+        self._retry_rejected = False
+        """`infer`'s, for the engine's runs of the frame it works on."""
         self._landmarker: FaceRunner | None = None
         self._mirror_landmarker: FaceRunner | None = None
         self._single_landmarker: FaceRunner | None = None
@@ -172,8 +174,9 @@ class Landmarker(ClosesOnExit):
     def from_config(cls, config: Config, video: bool = False) -> Landmarker:
         """A landmarker with the model from `resolve_model` (fetched on first use if allowed)."""
         from roadgaze.landmarks.model_store import resolve_model
+        from roadgaze.mounting import CameraMounting
 
-        mounting = config.monitor.mounting()
+        mounting = CameraMounting.from_config(config.monitor)
         angles = (mounting.yaw_deg, mounting.pitch_deg, mounting.roll_deg)
         side = driver_image_side(config.monitor.cabin, *angles)
         return cls(config.landmarks, resolve_model(config.model), video=video, seat_side=side)
@@ -210,9 +213,12 @@ class Landmarker(ClosesOnExit):
         """`detect` of an image `prepare` made; the same errors but the image's."""
         return self.measure(self.infer(prepared, t_s))
 
-    def infer(self, prepared: PreparedImage, t_s: float | None = None) -> Inference:
+    def infer(
+        self, prepared: PreparedImage, t_s: float | None = None, *, retry_rejected: bool = False
+    ) -> Inference:
         """The engine on an image `prepare` made: the faces in pixels and, in VIDEO mode, the
-        driver.
+        driver. `retry_rejected` (the front end's, on dark and flat frames): an engine that can
+        (LiteRT) looks again at a face its landmark model rejected.
 
         Calls must come in frame order (one thread at a time); the errors are `detect`'s but the
         image's.
@@ -234,6 +240,7 @@ class Landmarker(ClosesOnExit):
         elif t_s is not None:
             raise ValueError("IMAGE mode takes no timestamp; construct with video=True")
         size = (rgb.shape[1], rgb.shape[0])
+        self._retry_rejected = retry_rejected
         if self._switch is not None and t_s is not None:
             faces = self._run_switching(mp_image, size, t_s, timestamp_ms)
         else:
@@ -331,7 +338,7 @@ class Landmarker(ClosesOnExit):
         tracking = landmarker if isinstance(landmarker, Tracking) else None
         if tracking is not None:
             # The rest of each face is left to `measure` (the loop's other thread).
-            tracked = tracking.track(mp_image, timestamp_ms)
+            tracked = tracking.track(mp_image, timestamp_ms, self._retry_rejected)
             results: list[FaceArrays] = [(points, None, None) for points in tracked]
         else:
             results = landmarker.run(mp_image, timestamp_ms)

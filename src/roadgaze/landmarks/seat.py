@@ -2,7 +2,7 @@
 cannot be told apart. Pure (the standard library's `math` only).
 
 **The seat side.** The camera is aimed at the driver's head from its mounting
-(`roadgaze.pose.mounting`): in the driver's frame (origin at the driver's head, x forward, y to
+(`roadgaze.mounting`): in the driver's frame (origin at the driver's head, x forward, y to
 the driver's left, z up) its axes are the columns of M = R(yaw, pitch, roll) = Rz(yaw) .
 Ry(-pitch) . Rx(roll), x_cam pointing from the head to the camera, the camera at d x_cam. It
 looks along -x_cam, so (z_cam up) its image's x grows along f x up = -x_cam x z_cam = y_cam.
@@ -75,7 +75,7 @@ def driver_image_side(
 ) -> int:
     """+1: the driver sits on the image's right of a passenger beside them; -1: on its left; 0:
     unknown (a camera beside the heads, or on its side). `cabin` is "lhd" or "rhd"; the angles
-    are the camera mounting's (`roadgaze.pose.mounting.CameraMounting`, degrees). See the module
+    are the camera mounting's (`roadgaze.mounting.CameraMounting`, degrees). See the module
     doc; raises ValueError for another cabin."""
     if cabin not in ("lhd", "rhd"):
         raise ValueError(f"unknown cabin {cabin!r}; choose lhd or rhd")

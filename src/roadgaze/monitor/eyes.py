@@ -24,41 +24,39 @@ Definitions (thresholds in `MonitorConfig`; defaults and sources in docs/monitor
   The calibration, the road pitch and the open-eye baseline learn from open-eyed samples on the
   road with a steady head (|yaw rate| <= `neutral_max_rate_dps`).
 
-Events (raised only while moving): `microsleep` (warning) at a closure of `microsleep_s`,
-`sleep` (critical) at `sleep_s`, `unresponsive` (critical) at `unresponsive_closed_s`; `drowsy`
-(warning) at PERCLOS >= `perclos_drowsy` or `long_blinks_drowsy` long blinks in the window,
-re-armed below `perclos_rearm` and fewer long blinks; `degraded` (warning) after the eyes were
-unavailable for `degraded_after_s`.
+- **Degraded**: the eyes unavailable while moving for `degraded_after_s` (monitoring on the head
+  pose alone), until they are judged again.
+
+`measure_eyes` measures all this once per sample, before the behaviours run; the alerts are the
+behaviours' (roadgaze.monitor.behaviours: `eye_closure`, `drowsy`, `degraded`). `step_eyes` runs
+the eyes alone: the measurement and those three behaviours (roadgaze.monitor.eyes_alone).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.eye_calibration import EyeCalibration, eye_shift_deg, learn_calibration
 from roadgaze.monitor.eye_rules import POPULATION_OPEN, classify_eyes, gaze_deg, soft_threshold
-from roadgaze.types import AlertKind, AlertLevel, EyeStatus, EyesVerdict, PoseSample
+from roadgaze.types import AlertKind, EyesFeatures, EyeStatus, EyesVerdict, PoseSample
 
 __all__ = [
     "CLOSURE_KINDS",
     "POPULATION_OPEN",
-    "EyeEvent",
     "EyeMonitorState",
     "classify_eyes",
-    "clearable_eye_kinds",
     "eyes_verdict",
     "gaze_deg",
+    "measure_eyes",
     "soft_threshold",
-    "step_eyes",
 ]
 
-EyeEvent = tuple[AlertKind, AlertLevel, str]
-"""An alert the eyes call for: kind, level and reason (the monitor stamps the rest)."""
 CLOSURE_KINDS = (AlertKind.MICROSLEEP, AlertKind.SLEEP)
-"""Alerts of a closure; `unresponsive` may come from a closure too (then it is in
-`EyeMonitorState.closure_raised`)."""
+"""Alerts of a closure only (a closure may raise `unresponsive` too: roadgaze.monitor.behaviours
+.eye_closure)."""
 _EPS_S = 1e-6
 _MAX_GAP_S = 0.5
 """A longer gap between samples is not judged time (PERCLOS) and ends a closure."""
@@ -70,8 +68,8 @@ _BASELINE_TIME_CONSTANT_S = 120.0
 
 @dataclass(frozen=True, slots=True)
 class EyeMonitorState:
-    """What the eye monitor remembers between samples; replace, never mutate. Bounded: blinks
-    and PERCLOS bins older than the window are dropped."""
+    """What the eye measurement remembers between samples; replace, never mutate. Bounded:
+    blinks and PERCLOS bins older than the window are dropped."""
 
     t_s: float | None = None
     status: EyeStatus = EyeStatus.UNAVAILABLE
@@ -79,13 +77,10 @@ class EyeMonitorState:
     judged_at_s: float | None = None
     """Last sample with the eyes judged open or closed."""
     closure_since_s: float | None = None
-    closure_raised: tuple[AlertKind, ...] = ()
-    """Alerts already raised for the current closure."""
     blinks: tuple[tuple[float, float], ...] = ()
     """(end time, duration) of the blinks within the window."""
     bins: tuple[tuple[int, float, float], ...] = ()
     """PERCLOS bins within the window: (index of the second, closed s, judged s)."""
-    drowsy_armed: bool = True
     road_pitch_deg: float | None = None
     """The head's MediaPipe pitch looking at the road (learned)."""
     calibration: EyeCalibration = field(default_factory=EyeCalibration)
@@ -95,6 +90,7 @@ class EyeMonitorState:
     open_baseline: float | None = None
     unavailable_since_s: float | None = None
     degraded: bool = False
+    """Monitoring degraded: the eyes unavailable `degraded_after_s` while moving, until judged."""
     verdict: EyesVerdict = field(default_factory=EyesVerdict)
 
     @property
@@ -145,7 +141,7 @@ def _learn(value: float, target: float, dt_s: float, learned_s: float, limit: fl
     return max(-limit, min(limit, value + min(1.0, weight) * (target - value)))
 
 
-def step_eyes(
+def measure_eyes(
     config: MonitorConfig,
     state: EyeMonitorState,
     sample: PoseSample,
@@ -153,8 +149,8 @@ def step_eyes(
     on_road: bool,
     head_yaw_deg: float | None,
     head_pitch_deg: float | None,
-) -> tuple[EyeMonitorState, tuple[EyeEvent, ...]]:
-    """Advance by one sample; returns the new state and the events it calls for.
+) -> EyeMonitorState:
+    """Measure the eyes at one more sample; returns the new state.
 
     `on_road`: the monitor's road decision at the previous sample (the neutral values learn only
     on road). `head_yaw_deg`, `head_pitch_deg`: the head pose the gaze is built on (None without
@@ -162,11 +158,55 @@ def step_eyes(
     """
     t = sample.t_s
     if not math.isfinite(t) or (state.t_s is not None and t <= state.t_s):
-        return state, ()
+        return state
     dt = 0.0 if state.t_s is None else t - state.t_s
     eyes = sample.eyes if sample.face else None
     features = sample.features if sample.face else None
     mp_pitch = None if features is None else features.mediapipe_pitch_deg
+    status, reason, judged_at = _judge(config, state, sample, eyes, mp_pitch, dt)
+    # PERCLOS: the interval since the last sample, at the last sample's judgement.
+    bins = state.bins
+    if state.t_s is not None and state.status is not EyeStatus.UNAVAILABLE and dt <= _MAX_GAP_S:
+        bins = _add_judged_time(bins, state.t_s, t, state.status is EyeStatus.CLOSED)
+    oldest = math.floor((t - config.perclos_window_s) / _BIN_S)
+    bins = tuple(b for b in bins if b[0] > oldest)
+    closure_since, blinks = _closures(config, state, status, t, dt)
+    steady = _steady(config, sample.yaw_rate_dps)
+    open_on_road = status is EyeStatus.OPEN and not reason and on_road and eyes is not None
+    learned = state
+    if open_on_road and steady and dt > 0 and eyes is not None:
+        learned = _learn_rest(config, state, eyes, mp_pitch, dt)
+    unavailable_since, degraded = _unavailable(config, state, status, moving, t)
+    measured = EyeMonitorState(
+        t_s=t,
+        status=status,
+        reason=reason,
+        judged_at_s=judged_at,
+        closure_since_s=closure_since,
+        blinks=blinks,
+        bins=bins,
+        road_pitch_deg=learned.road_pitch_deg,
+        calibration=learned.calibration,
+        learned_s=learned.learned_s,
+        open_baseline=learned.open_baseline,
+        unavailable_since_s=unavailable_since,
+        degraded=degraded,
+    )
+    verdict = _verdict(config, measured, eyes, head_yaw_deg, head_pitch_deg)
+    return replace(measured, verdict=verdict)
+
+
+def _judge(
+    config: MonitorConfig,
+    state: EyeMonitorState,
+    sample: PoseSample,
+    eyes: EyesFeatures | None,
+    mp_pitch: float | None,
+    dt: float,
+) -> tuple[EyeStatus, str, float | None]:
+    """Open, closed or unavailable at this sample, why, and the last time the eyes were judged
+    (up to `closure_gap_s` of unavailable eyes inside a closure keeps it closed)."""
+    t = sample.t_s
     below = (
         None
         if mp_pitch is None or state.road_pitch_deg is None
@@ -177,27 +217,25 @@ def step_eyes(
     if not sample.face:
         reason = "no face"
     judged_at = state.judged_at_s
-    if status is EyeStatus.UNAVAILABLE:
-        bridging = (
-            state.status is EyeStatus.CLOSED
-            and judged_at is not None
-            and t - judged_at <= config.closure_gap_s + _EPS_S
-            and dt <= _MAX_GAP_S
-        )
-        if bridging:
-            status, reason = EyeStatus.CLOSED, "eyes closed"
-    else:
-        judged_at = t
+    if status is not EyeStatus.UNAVAILABLE:
+        return status, reason, t
+    bridging = (
+        state.status is EyeStatus.CLOSED
+        and judged_at is not None
+        and t - judged_at <= config.closure_gap_s + _EPS_S
+        and dt <= _MAX_GAP_S
+    )
+    if bridging:
+        return EyeStatus.CLOSED, "eyes closed", judged_at
+    return status, reason, judged_at
 
-    # PERCLOS: the interval since the last sample, at the last sample's judgement.
-    bins = state.bins
-    if state.t_s is not None and state.status is not EyeStatus.UNAVAILABLE and dt <= _MAX_GAP_S:
-        bins = _add_judged_time(bins, state.t_s, t, state.status is EyeStatus.CLOSED)
-    oldest = math.floor((t - config.perclos_window_s) / _BIN_S)
-    bins = tuple(b for b in bins if b[0] > oldest)
 
-    # Closure episodes and blinks.
-    closure_since, raised = state.closure_since_s, state.closure_raised
+def _closures(
+    config: MonitorConfig, state: EyeMonitorState, status: EyeStatus, t: float, dt: float
+) -> tuple[float | None, tuple[tuple[float, float], ...]]:
+    """The current closure's start (None: the eyes are not closed) and the blinks in the window:
+    a closure that ends open before `microsleep_s` is a blink."""
+    closure_since = state.closure_since_s
     blinks = tuple(b for b in state.blinks if b[0] > t - config.perclos_window_s)
     if status is EyeStatus.CLOSED:
         closure_since = t if closure_since is None or dt > _MAX_GAP_S else closure_since
@@ -205,32 +243,53 @@ def step_eyes(
         duration = t - closure_since
         if status is EyeStatus.OPEN and duration < config.microsleep_s - _EPS_S:
             blinks = (*blinks, (t, duration))[-_MAX_BLINKS:]
-        closure_since, raised = None, ()
-    closure_s = 0.0 if closure_since is None else t - closure_since
+        closure_since = None
+    return closure_since, blinks
 
-    # Neutral values, learned from open-eyed samples on the road with a steady head.
+
+def _steady(config: MonitorConfig, rate_dps: float | None) -> bool:
+    limit = config.neutral_max_rate_dps
+    return (
+        rate_dps is None or limit is None or not math.isfinite(rate_dps) or abs(rate_dps) <= limit
+    )
+
+
+def _learn_rest(
+    config: MonitorConfig,
+    state: EyeMonitorState,
+    eyes: EyesFeatures,
+    mp_pitch: float | None,
+    dt: float,
+) -> EyeMonitorState:
+    """The neutral values learned from an open-eyed sample on the road with a steady head: the
+    road pitch, the eye calibration, the open-eye baseline."""
     road_pitch, calibration, learned_s = state.road_pitch_deg, state.calibration, state.learned_s
     baseline = state.open_baseline
-    rate, max_rate = sample.yaw_rate_dps, config.neutral_max_rate_dps
-    steady = rate is None or max_rate is None or not math.isfinite(rate) or abs(rate) <= max_rate
-    open_on_road = status is EyeStatus.OPEN and not reason and on_road and eyes is not None
-    if open_on_road and steady and dt > 0 and eyes is not None:
-        if mp_pitch is not None:
-            road_pitch = (
-                mp_pitch
-                if road_pitch is None
-                else _learn(road_pitch, mp_pitch, dt, learned_s, 90.0)
-            )
-        if eyes.yaw_deg is not None and eyes.pitch_deg is not None:
-            calibration = learn_calibration(config, calibration, eyes.yaw_deg, eyes.pitch_deg, dt)
-        if eyes.openness is not None:
-            gain = 1.0 - math.exp(-min(dt, 1.0) / _BASELINE_TIME_CONSTANT_S)
-            baseline = (
-                eyes.openness if baseline is None else baseline + gain * (eyes.openness - baseline)
-            )
-        learned_s += min(dt, 1.0)
+    if mp_pitch is not None:
+        road_pitch = (
+            mp_pitch if road_pitch is None else _learn(road_pitch, mp_pitch, dt, learned_s, 90.0)
+        )
+    if eyes.yaw_deg is not None and eyes.pitch_deg is not None:
+        calibration = learn_calibration(config, calibration, eyes.yaw_deg, eyes.pitch_deg, dt)
+    if eyes.openness is not None:
+        gain = 1.0 - math.exp(-min(dt, 1.0) / _BASELINE_TIME_CONSTANT_S)
+        baseline = (
+            eyes.openness if baseline is None else baseline + gain * (eyes.openness - baseline)
+        )
+    return replace(
+        state,
+        road_pitch_deg=road_pitch,
+        calibration=calibration,
+        learned_s=learned_s + min(dt, 1.0),
+        open_baseline=baseline,
+    )
 
-    # Unavailable eyes while moving -> degraded.
+
+def _unavailable(
+    config: MonitorConfig, state: EyeMonitorState, status: EyeStatus, moving: bool, t: float
+) -> tuple[float | None, bool]:
+    """Since when the eyes have been unavailable while moving, and whether monitoring is
+    degraded (`degraded_after_s` of it, until the eyes are judged again)."""
     unavailable_since, degraded = state.unavailable_since_s, state.degraded
     if status is EyeStatus.UNAVAILABLE and moving:
         unavailable_since = t if unavailable_since is None else unavailable_since
@@ -238,38 +297,22 @@ def step_eyes(
         unavailable_since = None
         if status is not EyeStatus.UNAVAILABLE:
             degraded = False
-
-    events: list[EyeEvent] = []
-    if moving and closure_since is not None:
-        for kind, level, threshold_s in (
-            (AlertKind.MICROSLEEP, AlertLevel.WARNING, config.microsleep_s),
-            (AlertKind.SLEEP, AlertLevel.CRITICAL, config.sleep_s),
-            (AlertKind.UNRESPONSIVE, AlertLevel.CRITICAL, config.unresponsive_closed_s),
-        ):
-            if closure_s >= threshold_s - _EPS_S and kind not in raised:
-                events.append((kind, level, f"eyes closed {closure_s:.1f} s"))
-                raised = (*raised, kind)
-    perclos = _perclos(config, bins)
-    long_blinks = sum(1 for _, d in blinks if d >= config.long_blink_s - _EPS_S)
-    drowsy_armed = state.drowsy_armed
-    by_perclos = perclos is not None and perclos >= config.perclos_drowsy - _EPS_S
-    by_blinks = long_blinks >= config.long_blinks_drowsy
-    if moving and drowsy_armed and (by_perclos or by_blinks):
-        why = f"PERCLOS {perclos:.2f}" if by_perclos and perclos is not None else "long blinks"
-        events.append((AlertKind.DROWSY, AlertLevel.WARNING, why))
-        drowsy_armed = False
-    elif not drowsy_armed and not by_blinks and (perclos is None or perclos < config.perclos_rearm):
-        drowsy_armed = True
     unavailable_s = 0.0 if unavailable_since is None else t - unavailable_since
-    if (
-        unavailable_since is not None
-        and not degraded
-        and unavailable_s >= config.degraded_after_s - _EPS_S
-    ):
-        events.append((AlertKind.DEGRADED, AlertLevel.WARNING, f"eyes unavailable: {reason}"))
+    if unavailable_since is not None and unavailable_s >= config.degraded_after_s - _EPS_S:
         degraded = True
+    return unavailable_since, degraded
 
-    # Gaze: the calibrated eyes when open and giving a direction, else the head pose.
+
+def _verdict(
+    config: MonitorConfig,
+    state: EyeMonitorState,
+    eyes: EyesFeatures | None,
+    head_yaw_deg: float | None,
+    head_pitch_deg: float | None,
+) -> EyesVerdict:
+    """The eyes' part of the frame's verdict. Gaze: the calibrated eyes when open and giving a
+    direction, else the head pose."""
+    status, calibration, blinks = state.status, state.calibration, state.blinks
     gaze_yaw = gaze_pitch = None
     source = "none"
     if head_yaw_deg is not None:
@@ -283,44 +326,24 @@ def step_eyes(
         if shift is not None:
             gaze_yaw, gaze_pitch, source = gaze_yaw + shift[0], gaze_pitch + shift[1], "eyes"
     judged = status is not EyeStatus.UNAVAILABLE
-    verdict = EyesVerdict(
+    return EyesVerdict(
         status=status,
-        reason=reason,
+        reason=state.reason,
         openness=None if eyes is None or not judged else eyes.openness,
         eye_yaw_deg=None if eyes is None else eyes.yaw_deg,
         eye_pitch_deg=None if eyes is None else eyes.pitch_deg,
         gaze_yaw_deg=gaze_yaw,
         gaze_pitch_deg=gaze_pitch,
         gaze_source=source,
-        closure_s=closure_s,
-        perclos=perclos,
+        closure_s=state.closure_s(),
+        perclos=_perclos(config, state.bins),
         blinks=len(blinks),
-        long_blinks=long_blinks,
+        long_blinks=sum(1 for _, d in blinks if d >= config.long_blink_s - _EPS_S),
         last_blink_s=blinks[-1][1] if blinks else None,
-        unavailable_s=unavailable_s,
-        degraded=degraded,
+        unavailable_s=state.unavailable_s(),
+        degraded=state.degraded,
         calibration=calibration.status(),
     )
-    new_state = replace(
-        state,
-        t_s=t,
-        status=status,
-        reason=reason,
-        judged_at_s=judged_at,
-        closure_since_s=closure_since,
-        closure_raised=raised,
-        blinks=blinks,
-        bins=bins,
-        drowsy_armed=drowsy_armed,
-        road_pitch_deg=road_pitch,
-        calibration=calibration,
-        learned_s=learned_s,
-        open_baseline=baseline,
-        unavailable_since_s=unavailable_since,
-        degraded=degraded,
-        verdict=verdict,
-    )
-    return new_state, tuple(events)
 
 
 def eyes_verdict(state: EyeMonitorState) -> EyesVerdict:
@@ -328,15 +351,11 @@ def eyes_verdict(state: EyeMonitorState) -> EyesVerdict:
     return state.verdict
 
 
-def clearable_eye_kinds(state: EyeMonitorState, on_road: bool) -> frozenset[AlertKind]:
-    """The eye alerts whose cause has ended at the last sample: a closure once the eyes are
-    open on the road again, `drowsy` once re-armed, `degraded` once the eyes are back."""
-    kinds: set[AlertKind] = set()
-    if state.status is EyeStatus.OPEN and on_road:
-        kinds.update(CLOSURE_KINDS)
-        kinds.add(AlertKind.UNRESPONSIVE)
-    if state.drowsy_armed:
-        kinds.add(AlertKind.DROWSY)
-    if not state.degraded:
-        kinds.add(AlertKind.DEGRADED)
-    return frozenset(kinds)
+def __getattr__(name: str) -> Any:
+    """`step_eyes`, `EyesAlone` and `clearable_eye_kinds` live in roadgaze.monitor.eyes_alone
+    (they run the eye behaviours, which read this module): importable from here as before."""
+    if name in ("step_eyes", "EyesAlone", "clearable_eye_kinds"):
+        from roadgaze.monitor import eyes_alone
+
+        return getattr(eyes_alone, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

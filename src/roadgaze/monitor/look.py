@@ -1,6 +1,6 @@
-"""Where the driver looks at one sample: the zone from the head pose or the eyes, and the head
-pose mapped from the camera's frame into the driver's. Pure; part of
-`roadgaze.monitor.inattention.step`."""
+"""Where the driver looks at one sample: the zone from the head pose or the eyes (with hysteresis,
+and through face losses), and the head pose mapped from the camera's frame into the driver's.
+Pure; measured once per sample before the behaviours run (`roadgaze.monitor.context`)."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ from dataclasses import dataclass, replace
 
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.eye_rules import eye_zone_map
-from roadgaze.monitor.state import MonitorState
+from roadgaze.monitor.neutral import NeutralPose
 from roadgaze.monitor.zones import AWAY, ROAD, ZoneMap
-from roadgaze.pose.mounting import CameraMounting, gaze_to_driver
+from roadgaze.mounting import CameraMounting, gaze_to_driver
 from roadgaze.types import EyesVerdict, Gaze, PoseSample
 
 __all__ = ["Look", "classify", "finite", "to_driver_frame"]
@@ -19,7 +19,7 @@ __all__ = ["Look", "classify", "finite", "to_driver_frame"]
 
 def to_driver_frame(mounting: CameraMounting, sample: PoseSample) -> PoseSample:
     """The sample with its yaw and pitch (smoothed and raw) in the driver's frame
-    (roadgaze.pose.mounting); unchanged for a camera in front. A sample without a pitch is
+    (roadgaze.mounting); unchanged for a camera in front. A sample without a pitch is
     mapped at level pitch and keeps no pitch."""
     if mounting.is_identity or not sample.face:
         return sample
@@ -47,16 +47,30 @@ def finite(smoothed: float | None, raw: float | None) -> float | None:
 
 @dataclass(frozen=True, slots=True)
 class Look:
-    """Where the driver looks at one sample, as `_classify` judged it."""
+    """Where the driver looks at one sample, as `classify` judged it; the next sample's zone is
+    judged from it (hysteresis, face losses)."""
 
-    gaze: Gaze
-    zone: str | None
-    face_zone: str
-    yaw_deg: float | None
-    pitch_deg: float | None
-    lost_since_s: float | None
-    turned_away: bool
+    gaze: Gaze = Gaze.ON_ROAD
+    zone: str | None = ROAD
+    """This sample's zone; None when the gaze is unknown."""
+    face_zone: str = ROAD
+    """The zone of the last sample with a usable yaw: the hysteresis state, kept through face
+    losses."""
+    yaw_deg: float | None = None
+    pitch_deg: float | None = None
+    lost_since_s: float | None = None
+    """When the face was lost (None: it is seen)."""
+    turned_away: bool = False
+    """The face was lost while the head was turned away: off road, not unknown."""
     by_eyes: bool = False
+    """The zone was judged on the eyes' gaze, not the head pose."""
+    last_face_yaw_deg: float | None = None
+    """The yaw of the last sample with a usable yaw."""
+
+    @property
+    def on_road(self) -> bool:
+        """The hysteresis state: the last judged zone is the road."""
+        return self.face_zone == ROAD
 
     @property
     def why(self) -> str:
@@ -81,29 +95,47 @@ def _eyes_moved(eyes: EyesVerdict, head_yaw_deg: float, head_pitch_deg: float) -
 def classify(
     config: MonitorConfig,
     zones: ZoneMap,
-    state: MonitorState,
+    previous: Look,
+    neutral: NeutralPose,
     sample: PoseSample,
-    t_s: float,
     eyes: EyesVerdict,
 ) -> Look:
+    """Where the driver looks at `sample` (in the driver's frame), after `previous`."""
+    gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes = _judge(
+        config, zones, previous, neutral, sample, eyes
+    )
+    last_yaw = yaw if yaw is not None else previous.last_face_yaw_deg
+    return Look(gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes, last_yaw)
+
+
+def _judge(
+    config: MonitorConfig,
+    zones: ZoneMap,
+    previous: Look,
+    neutral: NeutralPose,
+    sample: PoseSample,
+    eyes: EyesVerdict,
+) -> tuple[Gaze, str | None, str, float | None, float | None, float | None, bool, bool]:
+    """Gaze, zone, face zone, yaw, pitch, face lost since, turned away, judged by the eyes."""
+    t_s = sample.t_s
     yaw = finite(sample.yaw_deg, sample.yaw_raw_deg) if sample.face else None
     pitch = finite(sample.pitch_deg, sample.pitch_raw_deg) if sample.face else None
     if sample.face:
         if yaw is None:  # a face whose yaw the model cannot explain: keep the last decision
-            zone = state.face_zone
+            zone = previous.face_zone
         else:
-            pitch_offset = 0.0 if pitch is None else pitch - state.neutral_pitch_deg
-            zone = zones.classify(yaw - state.neutral_yaw_deg, pitch_offset, state.face_zone)
-            if _eyes_moved(eyes, yaw, state.neutral_pitch_deg if pitch is None else pitch):
+            pitch_offset = 0.0 if pitch is None else pitch - neutral.pitch_deg
+            zone = zones.classify(yaw - neutral.yaw_deg, pitch_offset, previous.face_zone)
+            if _eyes_moved(eyes, yaw, neutral.pitch_deg if pitch is None else pitch):
                 # An eye glance: judged on the gaze, on a narrower road. The eyes may take the
                 # gaze off a road the head is on, never back onto it: a head judged off road
                 # stays off road (fail-safe; MediaPipe's eye direction is least reliable with
                 # the head turned, where it can read the eyes turned back by 15-20 deg).
                 gaze_zones = eye_zone_map(zones, config.eyes_road_margin_deg)
                 gaze_zone = gaze_zones.classify(
-                    (eyes.gaze_yaw_deg or 0.0) - state.neutral_yaw_deg,
-                    (eyes.gaze_pitch_deg or 0.0) - state.neutral_pitch_deg,
-                    state.face_zone,
+                    (eyes.gaze_yaw_deg or 0.0) - neutral.yaw_deg,
+                    (eyes.gaze_pitch_deg or 0.0) - neutral.pitch_deg,
+                    previous.face_zone,
                 )
                 # Nor into a driving-related zone from one that is not (a look out of the side
                 # window read as a mirror glance: the rendered A-pillar drive read the eyes
@@ -113,20 +145,20 @@ def classify(
                     excused_head or not zones.is_driving_related(gaze_zone)
                 ):
                     gaze = Gaze.ON_ROAD if gaze_zone == ROAD else Gaze.OFF_ROAD
-                    return Look(gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, by_eyes=True)
+                    return gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, True
         gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
-        return Look(gaze, zone, zone, yaw, pitch, None, False)
-    if state.face_lost_since_s is not None:
-        lost_since, turned = state.face_lost_since_s, state.face_lost_turned_away
+        return gaze, zone, zone, yaw, pitch, None, False, False
+    if previous.lost_since_s is not None:
+        lost_since, turned = previous.lost_since_s, previous.turned_away
     else:
         lost_since = t_s
-        if config.turn_away_deg is None or state.last_face_yaw_deg is None:
-            turned = not state.on_road
+        if config.turn_away_deg is None or previous.last_face_yaw_deg is None:
+            turned = not previous.on_road
         else:
-            turned = abs(state.last_face_yaw_deg - state.neutral_yaw_deg) > config.turn_away_deg
+            turned = abs(previous.last_face_yaw_deg - neutral.yaw_deg) > config.turn_away_deg
     if not turned:
-        return Look(Gaze.UNKNOWN, None, state.face_zone, None, None, lost_since, False)
-    zone = state.face_zone
+        return Gaze.UNKNOWN, None, previous.face_zone, None, None, lost_since, False, False
+    zone = previous.face_zone
     if zone == ROAD or zones.is_driving_related(zone):  # out of view: no longer a mirror glance
         zone = AWAY
-    return Look(Gaze.OFF_ROAD, zone, zone, None, None, lost_since, True)
+    return Gaze.OFF_ROAD, zone, zone, None, None, lost_since, True, False

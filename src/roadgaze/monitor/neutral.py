@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from roadgaze.config import MonitorConfig
-from roadgaze.monitor.state import MonitorState
 
-__all__ = ["learn_neutral"]
+__all__ = ["NeutralPose", "learn_neutral"]
 
 _MAX_LEARNING_STEP_S = 1.0
 """A longer gap between samples teaches the neutral pose no more than one second would."""
@@ -16,20 +16,41 @@ SETTLE_S = 1.0
 (the pitch's own second) from a pitch outside the road's entry band of the neutral."""
 
 
+@dataclass(frozen=True, slots=True)
+class NeutralPose:
+    """The road-ahead head pose in the driver's frame (degrees), fixed or learned, and the road
+    time each angle has learned from (its running mean's weight)."""
+
+    yaw_deg: float = 0.0
+    pitch_deg: float = 0.0
+    yaw_learned_s: float = 0.0
+    pitch_learned_s: float = 0.0
+
+    @classmethod
+    def from_config(cls, config: MonitorConfig) -> NeutralPose:
+        """Before the first sample: the configured values, or 0 where they are learned."""
+        return cls(
+            yaw_deg=0.0 if config.neutral_yaw_deg is None else config.neutral_yaw_deg,
+            pitch_deg=0.0 if config.neutral_pitch_deg is None else config.neutral_pitch_deg,
+        )
+
+
 def _learn(value: float, neutral: float, gain: float, limit: float) -> float:
     return max(-limit, min(limit, neutral + gain * (value - neutral)))
 
 
 def learn_neutral(
     config: MonitorConfig,
-    state: MonitorState,
+    neutral: NeutralPose,
+    previous_t_s: float | None,
     yaw_deg: float | None,
     pitch_deg: float | None,
     t_s: float,
     yaw_rate_dps: float | None = None,
     judged_on_road: bool = True,
-) -> tuple[float, float, float, float]:
-    """The neutral yaw and pitch after this sample and the time each has learned from.
+) -> NeutralPose:
+    """The neutral pose after this sample (`previous_t_s`: the last sample's time; None: this is
+    the first, which teaches nothing).
 
     A sample teaches when the head looks ahead: its yaw within the road's entry bound
     (`road_half_width_deg - hysteresis_deg`) of the neutral yaw, and its pitch within
@@ -49,10 +70,10 @@ def learn_neutral(
     mean's (dt over the time learned so far): the neutral settles on the driver's road pose
     within seconds of the start and then follows it slowly.
     """
-    yaw, pitch = state.neutral_yaw_deg, state.neutral_pitch_deg
-    yaw_s, pitch_s = state.neutral_yaw_learned_s, state.neutral_pitch_learned_s
-    if yaw_deg is None or state.t_s is None:
-        return yaw, pitch, yaw_s, pitch_s
+    yaw, pitch = neutral.yaw_deg, neutral.pitch_deg
+    yaw_s, pitch_s = neutral.yaw_learned_s, neutral.pitch_learned_s
+    if yaw_deg is None or previous_t_s is None:
+        return neutral
     ahead = abs(yaw_deg - yaw) <= config.road_half_width_deg - config.hysteresis_deg
     level = pitch_deg is None or abs(pitch_deg) <= config.neutral_pitch_limit_deg
     if pitch_deg is not None and pitch_s >= SETTLE_S:
@@ -70,8 +91,8 @@ def learn_neutral(
     )
     settled = max(yaw_s, pitch_s) >= SETTLE_S
     if not (ahead and level and steady) or (settled and not judged_on_road):
-        return yaw, pitch, yaw_s, pitch_s
-    dt_s = min(t_s - state.t_s, _MAX_LEARNING_STEP_S)
+        return neutral
+    dt_s = min(t_s - previous_t_s, _MAX_LEARNING_STEP_S)
     slow_gain = 1.0 - math.exp(-dt_s / config.neutral_time_constant_s)
     if config.neutral_yaw_deg is None:
         gain = max(slow_gain, dt_s / (yaw_s + dt_s))
@@ -80,4 +101,4 @@ def learn_neutral(
         gain = max(slow_gain, dt_s / (pitch_s + dt_s))
         pitch = _learn(pitch_deg, pitch, gain, config.neutral_pitch_limit_deg)
         pitch_s += dt_s
-    return yaw, pitch, yaw_s, pitch_s
+    return NeutralPose(yaw, pitch, yaw_s, pitch_s)

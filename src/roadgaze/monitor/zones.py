@@ -28,6 +28,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from roadgaze.config import MonitorConfig
 from roadgaze.config.protocol import AREA1_ZONE_NAMES
 
 __all__ = [
@@ -133,6 +134,20 @@ class ZoneMap:
     """ADDW area 1: beyond +-this yaw is always `far_left` / `far_right`."""
     roof_pitch_deg: float = DEFAULT_ROOF_PITCH_DEG
     """ADDW area 1: above this pitch is always `roof`."""
+
+    @classmethod
+    def from_config(cls, config: MonitorConfig) -> ZoneMap:
+        """The zones of `[monitor]` as the monitor classifies with them, the road first."""
+        road_yaw = config.road_half_width_deg - config.hysteresis_deg
+        road = Zone(ROAD, -road_yaw, road_yaw, *config.road_pitch_deg)
+        others = tuple(Zone(z.name, *z.yaw_deg, *z.pitch_deg) for z in config.effective_zones())
+        return cls(
+            zones=(road, *others),
+            hysteresis_deg=config.hysteresis_deg,
+            driving_related=frozenset(config.driving_related_zones),
+            distraction_yaw_deg=config.distraction_yaw_deg,
+            roof_pitch_deg=config.roof_pitch_deg,
+        )
 
     def __post_init__(self) -> None:
         names = [zone.name for zone in self.zones]

@@ -30,11 +30,13 @@ from roadgaze.types import (
     Frame,
     FrameRecord,
     PoseSample,
+    Sink,
 )
 
 
-class AnnotatedVideoWriter(ClosesOnExit):
-    """Pipeline sink writing each frame with its record drawn on it (codec from the suffix).
+class AnnotatedVideoWriter(ClosesOnExit, Sink):
+    """Pipeline sink writing each frame with its record drawn on it (codec from the suffix); an
+    alert raised outside the loop has no frame to be drawn on (the next frames show it active).
 
     `monitor`: the monitor's configuration, for the timers' thresholds (optional).
     """

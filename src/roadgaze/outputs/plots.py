@@ -38,6 +38,7 @@ from roadgaze.types import (
     Frame,
     FrameRecord,
     Gaze,
+    Sink,
 )
 
 ALERT_COLOURS = {"warning": "tab:orange", "critical": "tab:red", "info": "tab:green"}
@@ -145,7 +146,7 @@ def alert_label(alert: Alert) -> str:
     return alert.kind.value if alert.kind is AlertKind.CLEARED else f"{alert.kind} {alert.level}"
 
 
-class YawPlot(ClosesOnExit):
+class YawPlot(ClosesOnExit, Sink):
     """Pipeline sink that collects every record and saves the PNG when closed.
 
     `monitor`: the monitor's configuration, for the road band (around each frame's learned
@@ -211,6 +212,10 @@ class YawPlot(ClosesOnExit):
         self.gaze.append(record.verdict.gaze)
         self.eye_status.append(record.verdict.eyes.status)
         self.alerts.extend(record.alerts)
+
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop: on the alert strip at its time."""
+        self.alerts.append(alert)
 
     def close(self) -> None:
         if self._closed:

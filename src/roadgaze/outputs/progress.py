@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from roadgaze.types import ClosesOnExit, Frame, FrameRecord
+from roadgaze.types import ClosesOnExit, Frame, FrameRecord, Sink
 
 
 def terminal_bar(total: int | None, description: str, unit: str, enabled: bool = True) -> Any:
@@ -21,7 +21,7 @@ def terminal_bar(total: int | None, description: str, unit: str, enabled: bool =
     )
 
 
-class ProgressBar(ClosesOnExit):
+class ProgressBar(ClosesOnExit, Sink):
     """A progress bar (frames, fps, ETA) as a sink; see `terminal_bar`."""
 
     def __init__(self, total: int | None, description: str = "replay") -> None:

@@ -4,7 +4,8 @@
 the pose sample's fields, then the monitor's verdict and the alerts raised on that frame.
 `RECORD_SCHEMA` types each of its fields (`alert_fields` and `ALERT_SCHEMA` do the same for one
 alert); columnar writers (the fleet's Parquet files) derive their schema from it.
-Every writer is a context manager and a pipeline sink (`on_record`, `close`).
+Every writer is a context manager and a pipeline sink (`on_record`, `on_alert`, `close`); an
+alert raised outside the frame loop is written as a row of its own (`alert_row`).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from roadgaze.types import (
     Hand,
     HandSide,
     PhoneJudgement,
+    Sink,
 )
 
 
@@ -181,6 +183,15 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
     }
 
 
+def alert_row(alert: Alert) -> dict[str, Any]:
+    """An alert raised outside the frame loop as a row of the record files: the fields of
+    `record_fields`, null but its time and its alert (`frame` null tells it from a frame)."""
+    row: dict[str, Any] = dict.fromkeys(RECORD_FIELDS)
+    row["t_s"] = round(alert.t_s, 6)
+    row["alerts"] = [alert.label]
+    return row
+
+
 def alert_fields(alert: Alert) -> dict[str, Any]:
     """One alert as a flat JSON-ready dict with the fields of `ALERT_SCHEMA`."""
     return {
@@ -262,7 +273,7 @@ def naming(path: Path | None) -> Iterator[None]:
         raise
 
 
-class JsonlWriter(ClosesOnExit):
+class JsonlWriter(ClosesOnExit, Sink):
     """One JSON object per record and line, flushed line by line (nothing lost on a crash).
 
     `target` is a path, or an open text stream (e.g. stdout) that is flushed but not closed.
@@ -279,12 +290,18 @@ class JsonlWriter(ClosesOnExit):
         self.records = 0
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self._write(record_fields(record))
+        self.records += 1
+
+    def on_alert(self, alert: Alert) -> None:
+        self._write(alert_row(alert))
+
+    def _write(self, fields: dict[str, Any]) -> None:
         assert self._file is not None, "writer is closed"
         with naming(self.path):
-            self._file.write(json.dumps(record_fields(record), allow_nan=False) + "\n")
+            self._file.write(json.dumps(fields, allow_nan=False) + "\n")
             if not self._owned:
                 self._file.flush()
-        self.records += 1
 
     def close(self) -> None:
         if self._file is not None:
@@ -296,7 +313,7 @@ class JsonlWriter(ClosesOnExit):
                     file.flush()
 
 
-class CsvWriter(ClosesOnExit):
+class CsvWriter(ClosesOnExit, Sink):
     """The same records as CSV; empty cells for null."""
 
     def __init__(self, path: str | Path) -> None:
@@ -306,14 +323,19 @@ class CsvWriter(ClosesOnExit):
         self.records = 0
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self._write(record_fields(record))
+        self.records += 1
+
+    def on_alert(self, alert: Alert) -> None:
+        self._write(alert_row(alert))
+
+    def _write(self, fields: dict[str, Any]) -> None:
         assert self._file is not None, "writer is closed"
-        fields = record_fields(record)
         with naming(self.path):
             if self._writer is None:
                 self._writer = csv.DictWriter(self._file, fieldnames=list(fields))
                 self._writer.writeheader()
             self._writer.writerow({k: "" if v is None else v for k, v in fields.items()})
-        self.records += 1
 
     def close(self) -> None:
         if self._file is not None:

@@ -4,7 +4,9 @@
 and no camera); `Pipeline.frames(source)` is the loop as an iterator; `Pipeline.run(source,
 sinks, stop=...)` drives it and hands every record, with its frame, to each sink. `run`,
 `replay`, `demo` and `bench` all use this loop; a sink only reads the record, so sinks are
-independent of each other and of their order.
+independent of each other and of their order. The `Sink` protocol lives in `roadgaze.types`;
+`roadgaze.pipeline.build_run` assembles a run's sinks and delivers the alerts raised outside the
+loop to each of them.
 """
 
 from __future__ import annotations
@@ -29,7 +31,6 @@ from roadgaze.monitor.failures import check_frame
 from roadgaze.phone.stage import PhoneStage
 from roadgaze.pipeline.handoff import Handoff
 from roadgaze.pipeline.runtime import Collector, loop_runtime
-from roadgaze.pipeline.speed import SpeedSource, VehicleSpeed, no_speed, vehicle_speed
 from roadgaze.pipeline.steps import (
     Decoded,
     DetectorSteps,
@@ -42,7 +43,8 @@ from roadgaze.pipeline.steps import (
 )
 from roadgaze.pipeline.timing import RunSummary, StageTimes, StageTimings
 from roadgaze.pose import PoseEstimator
-from roadgaze.types import Frame, FrameRecord, LandmarkDetector
+from roadgaze.speed import SpeedSource, VehicleSpeed, no_speed, vehicle_speed
+from roadgaze.types import Frame, FrameRecord, LandmarkDetector, Sink
 
 READ_AHEAD_FRAMES = 2
 """Frames a file source is decoded (and prepared) ahead of the loop: enough to hide decoding, few
@@ -58,14 +60,6 @@ class StopSignal(Protocol):
     """Anything with `is_set()`: a `threading.Event`, the daemon's `StopFlag`."""
 
     def is_set(self) -> bool: ...
-
-
-class Sink(Protocol):
-    """Receives every record, in order, with its frame; `close()` once at the end."""
-
-    def on_record(self, record: FrameRecord, frame: Frame) -> None: ...
-
-    def close(self) -> None: ...
 
 
 @dataclass(frozen=True, slots=True)

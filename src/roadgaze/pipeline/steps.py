@@ -14,8 +14,6 @@ hand-over between threads in its latency.
 from __future__ import annotations
 
 import logging
-import os
-import threading
 import time
 from collections import deque
 from collections.abc import Callable, Generator, Iterator
@@ -23,6 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from roadgaze.capture import FrameSource
+from roadgaze.threads import lower_this_thread_priority as lower_this_thread_priority
 from roadgaze.types import Detection, Frame, LandmarkDetector, RecordedDriver
 
 log = logging.getLogger(__name__)
@@ -31,20 +30,6 @@ DECODE_NICENESS = 10
 """How much lower than the rest of the loop the decode thread runs (Linux thread niceness). It
 works frames ahead, so it yields the core to the frame in flight (the loop's thread, MediaPipe's
 threads, Zenoh's) instead of delaying it."""
-
-
-def lower_this_thread_priority(niceness: int) -> None:
-    """Raise the calling thread's niceness by `niceness` (Linux: per thread; elsewhere nothing)."""
-    if not hasattr(os, "setpriority") or not hasattr(threading, "get_native_id"):
-        return
-    try:
-        thread_id = threading.get_native_id()
-        current = os.getpriority(os.PRIO_PROCESS, thread_id)
-        os.setpriority(os.PRIO_PROCESS, thread_id, min(19, current + niceness))
-    except OSError as exc:
-        log.debug(
-            "cannot lower the priority of thread %s: %s", threading.current_thread().name, exc
-        )
 
 
 def front_end_ms(inferred: Inferred) -> tuple[float, float]:

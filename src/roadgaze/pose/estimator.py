@@ -78,7 +78,7 @@ class PoseEstimator:
         return cls(
             smoothing=config.smoothing,
             yaw_model=config.geometry.model,
-            constants=config.geometry.face_constants(),
+            constants=FaceModelConstants.from_config(config.geometry),
             pose=config.pose,
             full_range=FullRangeConstants(*config.geometry.full_range_cue_deg),
         )

@@ -22,12 +22,15 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Protocol, overload
+from typing import TYPE_CHECKING, Any, Protocol, overload
 
 import numpy as np
 import numpy.typing as npt
 
 from roadgaze.types import FloatArray
+
+if TYPE_CHECKING:
+    from roadgaze.config import GeometryConfig
 
 __all__ = [
     "PAPER_CONSTANTS",
@@ -58,6 +61,11 @@ class FaceModelConstants:
     beta: float = 1.25
     gamma_c: float = 0.1269
     gamma_b: float = 0.5774
+
+    @classmethod
+    def from_config(cls, config: GeometryConfig) -> FaceModelConstants:
+        """The constants `[geometry]` configures."""
+        return cls(config.alpha, config.beta, config.gamma_c, config.gamma_b)
 
 
 PAPER_CONSTANTS = FaceModelConstants()

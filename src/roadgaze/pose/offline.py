@@ -21,7 +21,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from filterpy.kalman import KalmanFilter
 
 from roadgaze.config import SmoothingConfig
 from roadgaze.pose.smoothing import constant_velocity_model, robust_noise_std_deg
@@ -111,6 +110,10 @@ def _smooth_track(t_s: FloatArray, values: FloatArray, config: SmoothingConfig) 
         measured if math.isfinite(measured) else config.measurement_std_deg,
         config.min_measurement_std_deg,
     )
+    # Imported here: filterpy pulls in scipy.stats (about 2 s of CPU), which every command that
+    # imports the pose stage (`roadgaze --help`, `listen`, `run`) would pay at start otherwise.
+    from filterpy.kalman import KalmanFilter
+
     kalman = KalmanFilter(dim_x=2, dim_z=1)
     kalman.H = np.array([[1.0, 0.0]])
     kalman.R = np.array([[noise_std**2]])

@@ -1,4 +1,4 @@
-"""Service plumbing around the daemon's loop: stop signals, systemd's notify protocol, watchdog."""
+"""The daemon around the loop (`service.daemon`): stop signals, systemd notify, watchdog."""
 
 from roadgaze.service.sdnotify import Notifier, socket_address
 from roadgaze.service.signals import STOP_SIGNALS, StopFlag, signal_handlers, sigterm_as_interrupt

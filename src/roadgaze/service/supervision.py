@@ -32,7 +32,7 @@ from typing import Protocol, Self
 
 from roadgaze.capture import FrameSource, SourceStatus
 from roadgaze.service.sdnotify import Notifier
-from roadgaze.types import Frame, FrameRecord
+from roadgaze.types import Alert, Frame, FrameRecord
 
 log = logging.getLogger("roadgaze.daemon")
 
@@ -153,6 +153,10 @@ class Supervisor:
         if self.ping_every_s is not None and now - self._last_ping >= self.ping_every_s:
             self._last_ping = now
             self.notifier.watchdog()
+
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop: counted in the status line."""
+        self.alerts += 1
 
     def stopping(self, reason: str) -> None:
         """STOPPING=1 once (SIGTERM, end of the source, or an error)."""

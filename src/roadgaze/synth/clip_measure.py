@@ -180,7 +180,7 @@ def measure_clip(
     Raises ConfigError for a bad timeline, SourceError for an unusable photo and ModelError
     when the landmarker model is unavailable.
     """
-    from roadgaze.monitor import Monitor
+    from roadgaze.monitor import Monitor, ZoneMap
     from roadgaze.pose import PoseEstimator
 
     config = config if config is not None else Config()
@@ -247,7 +247,7 @@ def measure_clip(
             )
         )
         zones_seen.append(monitor.verdict.zone if found else None)
-    zone_map = monitor_config.zone_map()
+    zone_map = ZoneMap.from_config(monitor_config)
     truth_zone: list[str] = []
     previous = "road"
     for yaw_deg, pitch_deg in zip(true_yaw, true_pitch, strict=True):

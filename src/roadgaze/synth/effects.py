@@ -1,13 +1,15 @@
-"""What a camera in a car sees besides a face: sensor noise, sunglasses, a covered lens, no one.
+"""What a camera in a car sees besides a face: sensor noise, sunglasses, a covered lens, no one,
+the night.
 
 Used by the conformance scenarios (`roadgaze.conformance`) on top of `FaceRenderer` frames:
 
 - `sensor_noise`: Gaussian noise on every pixel (a real sensor never repeats a frame exactly, so
   a held pose must not read as a frozen camera; sigma 2 grey levels by default);
-- `sunglasses`: two dark lenses over the eyes of the turned mesh and a bridge between them (the
-  eyes cannot be judged; the head still can);
+- `sunglasses`: dark glasses on the turned head (`roadgaze.synth.wearables`; the eyes cannot be
+  judged, the head still can);
 - `covered_frame`: a lens covered by a hand or a cloth: dark and flat;
-- `background_frame` (`FaceRenderer.background`): the cabin without the driver (no face).
+- `background_frame` (`FaceRenderer.background`): the cabin without the driver (no face);
+- `night`: the picture of an infrared cabin camera at night (the condition suite's `ir_grey`).
 
 A frozen camera is the same frame delivered again: the caller repeats a frame without noise.
 """
@@ -16,16 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from roadgaze.landmarks.eye_landmarks import EYES
 from roadgaze.synth.renderer import FaceRenderer, ImageBGR
 
 NOISE_SIGMA = 2.0
 """Sensor noise, grey levels (a camera's read noise in daylight is 1-3 levels)."""
 COVERED_GREY = 6
 """The mean grey level of a covered lens (a little light leaks in)."""
-LENS_WIDTH_EYE_WIDTHS = 1.7
-"""A lens is this many eye widths wide (a typical lens is 50-55 mm for a 30 mm eye)."""
-LENS_BGR = (22, 20, 18)
 
 
 def sensor_noise(frame: ImageBGR, rng: np.random.Generator, sigma: float = NOISE_SIGMA) -> ImageBGR:
@@ -76,32 +74,20 @@ def covered_frame(size: tuple[int, int], rng: np.random.Generator) -> ImageBGR:
 def sunglasses(
     frame: ImageBGR, renderer: FaceRenderer, yaw_deg: float, pitch_deg: float
 ) -> ImageBGR:
-    """`frame` (the face rendered at `yaw_deg`, `pitch_deg`) with dark lenses over both eyes.
+    """`frame` (the face rendered at `yaw_deg`, `pitch_deg`) with dark sunglasses on
+    (`roadgaze.synth.wearables.glasses` with `DARK` lenses: the eyes cannot be judged; the head
+    still can)."""
+    from roadgaze.synth.wearables import DARK, glasses
 
-    Each lens is an ellipse around the eye's contour as the turned mesh places it,
-    `LENS_WIDTH_EYE_WIDTHS` eye widths wide and 0.8 of that tall (foreshortened with the eye);
-    a bridge joins the inner corners. An eye turned away from the camera gets no lens.
-    """
+    return glasses(frame, renderer, yaw_deg, pitch_deg, DARK)
+
+
+def night(frame: ImageBGR, rng: np.random.Generator) -> ImageBGR:
+    """`frame` as an infrared cabin camera sees it at night: the condition suite's `ir_grey`
+    (`roadgaze.evaluation.conditions`: one grey channel, contrast 0.4 about a mean of 120, sensor
+    noise of 6 levels), as three equal channels."""
     import cv2
 
-    points = renderer.turned_points(yaw_deg, pitch_deg)
-    out = frame.copy()
-    inner: list[tuple[int, int]] = []
-    for eye in EYES:
-        contour = points[list(eye.contour), :2]
-        width_px = float(np.hypot(*(points[eye.outer, :2] - points[eye.inner, :2])))
-        if width_px < 2.0:
-            continue
-        centre = contour.mean(axis=0)
-        axes = (
-            round(0.5 * LENS_WIDTH_EYE_WIDTHS * width_px),
-            round(0.4 * LENS_WIDTH_EYE_WIDTHS * width_px),
-        )
-        dx, dy = points[eye.outer, :2] - points[eye.inner, :2]
-        angle = float(np.degrees(np.arctan2(dy, dx)))
-        cv2.ellipse(out, (round(centre[0]), round(centre[1])), axes, angle, 0, 360, LENS_BGR, -1)
-        inner.append((round(points[eye.inner, 0]), round(points[eye.inner, 1])))
-    if len(inner) == 2:
-        thickness = max(2, round(0.02 * renderer.mesh.face_width_px))
-        cv2.line(out, inner[0], inner[1], LENS_BGR, thickness)
-    return out
+    from roadgaze.evaluation.conditions import ir_grey
+
+    return np.asarray(cv2.cvtColor(ir_grey(frame, rng), cv2.COLOR_GRAY2BGR), dtype=np.uint8)

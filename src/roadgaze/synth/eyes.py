@@ -29,6 +29,7 @@ docs/synth.md.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -37,6 +38,8 @@ import numpy.typing as npt
 
 from roadgaze.config import Config
 from roadgaze.landmarks.eyes import EYEBALL, EYES, EyeIndices
+from roadgaze.synth.eye_state import EyeState as EyeState
+from roadgaze.synth.layers import Layer
 from roadgaze.synth.renderer import (
     DEFAULT_SIZE,
     FaceRenderer,
@@ -58,32 +61,6 @@ LOWER_MARGIN_DROP_EYE_WIDTHS = 0.06
 astronaut photo: the opening is taken that much lower, so no sclera shows through a closed lid."""
 _FOLLOW_WEIGHTS = (0.55, 0.85, 1.0, 1.0, 1.0, 0.85, 0.55)
 """How far each upper-lid landmark (outer to inner) follows the gaze: the corners stay put."""
-
-
-@dataclass(frozen=True, slots=True)
-class EyeState:
-    """Truth for both eyes: eye-in-head yaw/pitch (degrees, project convention) and openness."""
-
-    eye_yaw_deg: float = 0.0
-    eye_pitch_deg: float = 0.0
-    openness_right: float = 1.0
-    openness_left: float = 1.0
-
-    @classmethod
-    def both(
-        cls, eye_yaw_deg: float = 0.0, eye_pitch_deg: float = 0.0, openness: float = 1.0
-    ) -> EyeState:
-        return cls(eye_yaw_deg, eye_pitch_deg, openness, openness)
-
-    @property
-    def at_rest(self) -> bool:
-        """Open as photographed and looking ahead: the texture needs no edit."""
-        return (
-            self.eye_yaw_deg == 0.0
-            and self.eye_pitch_deg == 0.0
-            and self.openness_right >= 1.0
-            and self.openness_left >= 1.0
-        )
 
 
 @dataclass(frozen=True, slots=True)
@@ -160,6 +137,8 @@ class EyeRenderer(FaceRenderer):
         self.lid_follow = lid_follow
         self.eyeball_at_rest = eyeball_at_rest
         self.base_texture: ImageBGR = np.asarray(self.texture, dtype=np.uint8)
+        self.over: Layer | None = None
+        self.rest_texture = self.base_texture
         self._patches = {eye.side: self._eye_patch(eye) for eye in EYES}
 
     def _contour(self, eye: EyeIndices) -> FloatArray:
@@ -350,7 +329,7 @@ class EyeRenderer(FaceRenderer):
         """The photo texture with both eyes drawn as `state` says, for this head pose."""
         head_moved = self.eyeball_at_rest and (yaw_deg != 0.0 or pitch_deg != 0.0)
         if state.at_rest and not head_moved:
-            return self.base_texture
+            return self.rest_texture
         texture = self.base_texture.copy()
         for eye, openness in ((EYES[0], state.openness_right), (EYES[1], state.openness_left)):
             patch = self._patches[eye.side]
@@ -367,7 +346,18 @@ class EyeRenderer(FaceRenderer):
             texture[patch.y0 : patch.y0 + height, patch.x0 : patch.x0 + columns] = np.clip(
                 region + 0.5, 0, 255
             ).astype(np.uint8)
-        return texture
+        return texture if self.over is None else self.over.over(texture)
+
+    def repainted(self, texture: ImageBGR, over: Layer | None = None) -> EyeRenderer:
+        """A copy whose photo texture is `texture` (paint under the eyes: the lids close over
+        it) with `over` composited after the eyes are drawn (`roadgaze.synth.layers`)."""
+        dressed = copy.copy(self)
+        dressed.base_texture = np.asarray(texture, dtype=np.uint8)
+        dressed._patches = {eye.side: dressed._eye_patch(eye) for eye in EYES}
+        dressed.over = over
+        dressed.rest_texture = dressed.base_texture if over is None else over.over(texture)
+        dressed.texture = dressed.rest_texture
+        return dressed
 
     @staticmethod
     def _lid_drop(patch: _EyePatch, drop_px: float) -> FloatArray:
@@ -381,10 +371,13 @@ class EyeRenderer(FaceRenderer):
             )
         return np.asarray(drop_px * weights, dtype=np.float64)
 
-    def render_eyes(self, yaw_deg: float, pitch_deg: float, state: EyeState) -> ImageBGR:
-        """One BGR frame: the head at yaw/pitch, the eyes as `state` says."""
+    def render_eyes(
+        self, yaw_deg: float, pitch_deg: float, state: EyeState, mouth_open: float = 0.0
+    ) -> ImageBGR:
+        """One BGR frame: the head at yaw/pitch, the eyes as `state` says, the jaw opened by
+        `mouth_open` (`roadgaze.synth.mouth`)."""
         self.texture = self.eye_texture(yaw_deg, pitch_deg, state)
         try:
-            return self.render(yaw_deg, pitch_deg)
+            return self.render(yaw_deg, pitch_deg, mouth_open)
         finally:
-            self.texture = self.base_texture
+            self.texture = self.rest_texture

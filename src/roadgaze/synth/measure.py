@@ -228,6 +228,7 @@ def measure_pitch_recovery(
     """
     from roadgaze.landmarks import Landmarker
     from roadgaze.landmarks.model_store import resolve_model
+    from roadgaze.monitor.zones import ZoneMap
     from roadgaze.pose import PoseEstimator, head_pitch_deg, midline_pitch_deg
 
     config = config if config is not None else Config()
@@ -262,7 +263,7 @@ def measure_pitch_recovery(
     if config.pose.pitch_model == "geometric":
         relative["service"] = relative["geometric"]
     yaw_relative = yaw - yaw[frontal]
-    zones = config.monitor.zone_map()
+    zones = ZoneMap.from_config(config.monitor)
     found = np.isfinite(yaw_relative)
     return PitchRecovery(
         truth_yaw_deg=truth[:, 0],

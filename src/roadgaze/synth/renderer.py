@@ -31,6 +31,7 @@ import numpy.typing as npt
 from roadgaze.config import Config
 from roadgaze.errors import ConfigError, SourceError
 from roadgaze.landmarks.features import FACE_OVAL, NOSE_TIP
+from roadgaze.synth.mouth import inside_triangles, jaw_of, paint_inside
 from roadgaze.types import FloatArray
 
 ImageBGR = npt.NDArray[np.uint8]
@@ -42,6 +43,8 @@ FACE_WIDTH_FRACTION = 0.32
 """Face width in the output frame as a fraction of the frame's smaller side."""
 TESSELLATION_TRIANGLES = 852
 CHIN = 152
+TEETH_BGR = (200, 215, 225)
+"""The teeth's colour where the photo shows none (a closed mouth)."""
 
 
 def default_photo_path() -> Path:
@@ -156,6 +159,8 @@ class FaceRenderer:
     Build once per photo and size (this runs MediaPipe once and in-paints the background), then
     call `render(yaw_deg, pitch_deg)` per frame. `size` is (width, height) in pixels;
     `landmarks_px` skips the landmarker (the photo's (478, 3) mesh), `config` chooses its model.
+    `render(..., mouth_open=f)` opens the jaw (`roadgaze.synth.mouth`); `show_mouth_inside`
+    False leaves the opened mouth as the texture has it (a face mask over it).
     """
 
     def __init__(
@@ -205,11 +210,21 @@ class FaceRenderer:
             ]
         )
         self.mesh = PhotoMesh(points, pivot, face_width_px)
+        self.jaw = jaw_of(points, face_width_px)
         self.triangles = mesh_triangles()
         self._front_sign = self._majority_sign(points)
-        backwards = self._signed_areas(points) * self._front_sign < 0
-        backwards[:TESSELLATION_TRIANGLES] = False  # only the hole fillers have no set winding
+        self.mouth_inside = inside_triangles(self.triangles)
+        # The hole fillers have no set winding: take it from the photo, and for a mouth closed
+        # too tightly to tell (a sliver under 0.5 px^2) from the jaw opened half way.
+        areas = self._signed_areas(points)
+        opened = self._signed_areas(self.jaw.open(points, 0.5))
+        slivers = np.intersect1d(self.mouth_inside, np.flatnonzero(np.abs(areas) < 0.5))
+        areas[slivers] = opened[slivers]
+        backwards = areas * self._front_sign < 0
+        backwards[:TESSELLATION_TRIANGLES] = False
         self.triangles[backwards] = self.triangles[backwards][:, ::-1]
+        self.show_mouth_inside = True
+        self.teeth_bgr = self._teeth_colour(cv2)
         self.background = self._inpaint_face(cv2)
         ys, xs = np.mgrid[0:height, 0:width]
         self._pixel_x = xs.astype(np.float64)
@@ -223,6 +238,18 @@ class FaceRenderer:
     def _majority_sign(self, points: FloatArray) -> float:
         return 1.0 if np.sum(self._signed_areas(points) > 0) >= len(self.triangles) / 2 else -1.0
 
+    def _teeth_colour(self, cv2: Any) -> FloatArray:
+        """The brightest quarter of the photo's open mouth (its teeth), or `TEETH_BGR`."""
+        mask = np.zeros(self.texture.shape[:2], dtype=np.uint8)
+        corners = np.round(self.mesh.points_px[self.triangles[self.mouth_inside], :2])
+        for triangle in corners.astype(np.int32):
+            cv2.fillConvexPoly(mask, triangle, 255)
+        pixels = self.texture[mask > 0].astype(np.float64)
+        if len(pixels) < 8:
+            return np.asarray(TEETH_BGR, dtype=np.float64)
+        luma = pixels.mean(axis=1)
+        return np.asarray(pixels[luma >= np.percentile(luma, 75)].mean(axis=0), dtype=np.float64)
+
     def _inpaint_face(self, cv2: Any) -> ImageBGR:
         """The texture with the face area (dilated by 6 % of the face width) filled smoothly."""
         mask = np.zeros(self.texture.shape[:2], dtype=np.uint8)
@@ -235,17 +262,22 @@ class FaceRenderer:
         background: ImageBGR = np.clip(filled + 0.5, 0, 255).astype(np.uint8)
         return background
 
-    def turned_points(self, yaw_deg: float, pitch_deg: float = 0.0) -> FloatArray:
-        """The mesh nodded by pitch (about the head's lateral axis), then turned by yaw (about
-        the vertical axis), both about the neck pivot: pitch is the elevation of the face's
-        forward direction, as in Pointing'04's tilt and MediaPipe's matrix angles."""
-        return turn_points(self.mesh.points_px, self.mesh.pivot_px, yaw_deg, pitch_deg)
+    def turned_points(
+        self, yaw_deg: float, pitch_deg: float = 0.0, mouth_open: float = 0.0
+    ) -> FloatArray:
+        """The mesh (its jaw opened by `mouth_open`, `roadgaze.synth.mouth`) nodded by pitch
+        (about the head's lateral axis), then turned by yaw (about the vertical axis), both about
+        the neck pivot: pitch is the elevation of the face's forward direction, as in
+        Pointing'04's tilt and MediaPipe's matrix angles."""
+        points = self.jaw.open(self.mesh.points_px, mouth_open)
+        return turn_points(points, self.mesh.pivot_px, yaw_deg, pitch_deg)
 
-    def render(self, yaw_deg: float, pitch_deg: float = 0.0) -> ImageBGR:
-        """One BGR frame of the face turned to `yaw_deg`, `pitch_deg` over the background."""
+    def render(self, yaw_deg: float, pitch_deg: float = 0.0, mouth_open: float = 0.0) -> ImageBGR:
+        """One BGR frame of the face turned to `yaw_deg`, `pitch_deg` over the background, the
+        jaw opened by `mouth_open` (a fraction of a wide yawn, `roadgaze.synth.mouth`)."""
         import cv2
 
-        turned = self.turned_points(yaw_deg, pitch_deg)
+        turned = self.turned_points(yaw_deg, pitch_deg, mouth_open)
         areas = self._signed_areas(turned) * self._front_sign
         visible = np.flatnonzero(areas > 0.05)  # back faces and edge-on slivers culled
         depth = turned[self.triangles[visible]][:, :, 2].mean(axis=1)
@@ -278,6 +310,9 @@ class FaceRenderer:
         )
         frame = self.background.copy()
         frame[covered] = face[covered]
+        if mouth_open > 0.0 and self.show_mouth_inside:
+            inside = np.isin(index, self.mouth_inside)
+            paint_inside(frame, inside, turned, self.teeth_bgr, self.mesh.face_width_px)
         return frame
 
 

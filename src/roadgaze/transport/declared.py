@@ -1,6 +1,8 @@
 """Everything the daemon's link declares on one open Zenoh session, closed together.
 
-The alert advanced publisher (cache, sample-miss detection, publisher detection), the VSS and yaw
+The alert advanced publisher (cache, sample-miss detection, publisher detection) with a plain
+publisher on the same key that is never put on (its matching status tells the alert ledger
+whether a subscriber is there, which the advanced publisher does not say), the VSS and yaw
 publishers, the speed subscriber (a ring of one), the state queryable with its responder thread
 and the liveliness token; see `roadgaze.transport.link` for their QoS and meaning.
 """
@@ -21,6 +23,17 @@ HEARTBEAT_S = 0.5
 """How often the alert publisher announces its last sequence number (lost-alert detection)."""
 
 
+def undeclare_all(entities: list[Any]) -> None:
+    """Undeclare Zenoh entities newest first and forget them; a failure is logged, never raised
+    (the session may be closing under them)."""
+    for entity in reversed(entities):
+        try:
+            entity.undeclare()
+        except Exception as exc:
+            log.debug("undeclare failed: %s", exc)
+    entities.clear()
+
+
 class Declared:
     """Everything declared on one open session; closed together."""
 
@@ -31,6 +44,7 @@ class Declared:
         self.session = session
         self._entities: list[Any] = []
         self.responder: StateResponder | None = None
+        self._on_matching = link.link_state.on_matching
         keys = link.keys
         try:
             self._entities.append(
@@ -52,6 +66,14 @@ class Declared:
                 publisher_detection=True,
             )
             self._entities.append(self.alert)
+            matching = session.declare_publisher(keys.alert)
+            self._entities.append(matching)
+            self._entities.append(
+                matching.declare_matching_listener(
+                    lambda status: self._on_matching(bool(status.matching))
+                )
+            )
+            self._on_matching(bool(matching.matching_status.matching))
             self.vss: dict[str, Any] = {}
             for key in link.vss_keys:
                 self.vss[key] = session.declare_publisher(
@@ -91,12 +113,8 @@ class Declared:
             raise
 
     def close(self) -> None:
-        for entity in reversed(self._entities):
-            try:
-                entity.undeclare()
-            except Exception as exc:
-                log.debug("undeclare failed: %s", exc)
-        self._entities.clear()
+        undeclare_all(self._entities)
+        self._on_matching(False)
         if self.responder is not None:
             self.responder.close()
         try:

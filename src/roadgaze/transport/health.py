@@ -17,6 +17,7 @@ from typing import Literal
 from roadgaze.capture import FrameSource
 from roadgaze.config import Config
 from roadgaze.monitor import initial_state, verdict_of
+from roadgaze.mounting import CameraMounting
 from roadgaze.transport.keys import Keys
 from roadgaze.transport.messages import (
     AlertMessage,
@@ -77,6 +78,10 @@ class Health:
             self.status = "running"
         for alert in record.alerts:
             self.note_alert(alert)
+
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop: counted and logged like the others."""
+        self.note_alert(alert)
 
     def note_alert(self, alert: Alert) -> None:
         """Count and log one alert (from a record, or raised outside the loop)."""
@@ -178,7 +183,7 @@ class Health:
                 alert_counts=dict(verdict.alert_counts),
                 eye_calibration=eyes.calibration,
                 protocol=monitor.protocol,
-                camera_mounting=monitor.mounting().name,
+                camera_mounting=CameraMounting.from_config(monitor).name,
                 distraction_s=max(0.0, verdict.distraction_s),
                 distraction_warn_s=verdict.distraction_warn_s,
                 distraction_rule=verdict.distraction_rule,

@@ -32,9 +32,10 @@ from collections.abc import Callable
 from typing import Any
 
 from roadgaze.config import ZenohConfig
-from roadgaze.transport.declared import HEARTBEAT_S, Declared
+from roadgaze.transport.declared import Declared
 from roadgaze.transport.keys import Keys
 from roadgaze.transport.ledger import NAMED_LOST, AlertId
+from roadgaze.transport.link_state import RECOVERY_GRACE_S as RECOVERY_GRACE_S
 from roadgaze.transport.link_state import LinkState
 from roadgaze.transport.messages import AlertMessage, TransportStatus, YawMessage
 from roadgaze.transport.session import (
@@ -49,10 +50,6 @@ from roadgaze.transport.speed import SpeedInput
 from roadgaze.transport.vss import VSS_ATTACHMENT
 
 log = logging.getLogger(__name__)
-
-RECOVERY_GRACE_S = 4 * HEARTBEAT_S
-"""After a link came back at exit: time for subscribers with recovery to fetch the held alerts
-(a heartbeat, their query, the answer)."""
 
 
 class ZenohLink:
@@ -231,31 +228,46 @@ class ZenohLink:
         return held + len(pending), gone, named + waiting[-NAMED_LOST:]
 
     def settle(self, wait_s: float, stop: Callable[[], bool] = lambda: False) -> None:
-        """Before closing: with alerts still waiting for a link, wait up to `wait_s` for one
-        (then a moment, so subscribers with recovery fetch them from the cache)."""
+        """Before closing: with alerts still waiting (no link, no subscriber, or one that just
+        came), wait up to `wait_s` for a link and a subscriber, then up to `RECOVERY_GRACE_S`
+        more for that subscriber to fetch them from the cache."""
         waiting = self.undelivered()[0]
         if not waiting or wait_s <= 0:
             return
         log.warning(
-            "%d alert%s not delivered yet: waiting up to %g s for a zenoh link "
+            "%d alert%s not delivered yet: waiting up to %g s for a zenoh link and a subscriber "
             "(zenoh.delivery_wait_s)",
             waiting,
             "" if waiting == 1 else "s",
             wait_s,
         )
         deadline = time.monotonic() + wait_s
-        while self.undelivered()[0] and time.monotonic() < deadline and not stop():
+        while self.undelivered()[0] and not stop():
+            settled = self.link_state.settled_at()
+            now = time.monotonic()
+            if now >= deadline + RECOVERY_GRACE_S or (settled is None and now >= deadline):
+                return
             time.sleep(0.05)
-        if not self.undelivered()[0]:
-            time.sleep(RECOVERY_GRACE_S)
 
-    def stop_ledger(self) -> None:
-        """At exit: alerts still waiting for a link (or a session) are gone."""
-        self.link_state.stopped()
+    def stop_ledger(self, ending: str = "the daemon stopped") -> None:
+        """At exit: alerts still waiting for a link (or a session, or a first subscriber) are
+        gone; those left on a bus whose subscribers have gone are named in a warning. `ending`
+        says what ended (`the replay ended`)."""
+        left = self.link_state.stopped(ending)
+        if left:
+            log.warning(
+                "%d alert%s published after the last subscriber left stay%s on the bus, not "
+                "fetched by a new one (zenoh.delivery_wait_s = %g s): %s",
+                len(left),
+                "" if len(left) == 1 else "s",
+                "s" if len(left) == 1 else "",
+                self.config.delivery_wait_s,
+                "; ".join(left[-NAMED_LOST:]),
+            )
         with self._lock:
             pending, self._pending = list(self._pending), deque(maxlen=self._pending.maxlen)
         for _, alert in pending:
-            self.link_state.gone(alert, "never published: no zenoh session when the daemon stopped")
+            self.link_state.gone(alert, f"never published: no zenoh session when {ending}")
 
     def status(self) -> TransportStatus:
         with self._lock:

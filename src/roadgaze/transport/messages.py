@@ -271,7 +271,8 @@ class TransportStatus(_Message):
         default=0,
         ge=0,
         description="roadgaze.state/4: alerts published while no link was up (or held before "
-        "the session opened) and still waiting for one; gone if the daemon stops first.",
+        "the session opened), or on a link with no subscriber yet, and still waiting for one; "
+        "gone if the daemon stops first.",
     )
     alerts_lost: int = Field(
         default=0,

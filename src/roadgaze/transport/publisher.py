@@ -52,6 +52,10 @@ class BusPublisher:
         for alert in record.alerts:
             self.publish_alert(alert, wall_time)
 
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop (a camera gone, a model unusable)."""
+        self.publish_alert(alert)
+
     def publish_alert(self, alert: Alert, wall_time: float | None = None) -> None:
         """Publish one alert with the next sequence number (also from outside the loop: the
         permanent failure watch)."""

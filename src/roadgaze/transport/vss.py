@@ -39,7 +39,7 @@ from typing import Protocol
 
 from roadgaze.config import MonitorConfig
 from roadgaze.transport.payloads import PayloadError, printable
-from roadgaze.types import EyeStatus, Frame, FrameRecord, Gaze
+from roadgaze.types import Alert, AlertKind, EyeStatus, Frame, FrameRecord, Gaze
 
 __all__ = [
     "VSS_ATTACHMENT",
@@ -247,6 +247,14 @@ class VssPublisher:
             self.link.publish_vss(self.keys[path], vss_text(value))
             self._sent[path] = (value, t_s)
             self.published += 1
+
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop: a permanent failure sets `IsError` and
+        `IsWarning` now, its `cleared` unsets them (a record would come too late or never)."""
+        if alert.kind is AlertKind.PERMANENT_FAILURE:
+            self.publish_failure(True)
+        elif AlertKind.PERMANENT_FAILURE in alert.clears:
+            self.publish_failure(False)
 
     def publish_failure(self, failed: bool) -> None:
         """Send `ADAS.DMS.IsError` (and `IsWarning`) now: a permanent failure raised or cleared

@@ -81,7 +81,9 @@ def _relay(stream: IO[bytes]) -> None:
         if throttle is None:
             if len(throttles) >= 64:  # bounded: a peer cannot grow this table
                 throttles.clear()
-            throttle = throttles[line.kind] = ThrottledWarning(log, "zenoh", WARNING_PERIOD_S)
+            throttle = throttles[line.kind] = ThrottledWarning(
+                log, f"zenoh {line.target}", WARNING_PERIOD_S
+            )
         throttle(line.message)
 
 

@@ -238,3 +238,41 @@ def test_a_port_in_use_is_one_line() -> None:
             vehicle_recorder(Config(), "numbered", None, f"127.0.0.1:{port}")
     finally:
         first.close()
+
+
+def test_a_hostile_client_gets_one_log_line_per_period_not_one_per_bad_frame(
+    live: tuple[FoxgloveRecorder, LiveServer], caplog: pytest.LogCaptureFixture
+) -> None:
+    """Issue 34: a client sending bad frames got one log line each (36,150 in 45 s). Now the
+    first is logged, then one per 10 s with the count held back, and the rest at the stop."""
+    recorder, server = live
+    sent = 1000  # each gets a status reply; a client whose reply queue fills is dropped
+    frames = ["not json", b"\x99garbage", '{"op": "subscribe", "subscriptions": [{"id": 1}]}']
+    with (
+        caplog.at_level(logging.WARNING),
+        connect(server.url, subprotocols=[SUBPROTOCOL]) as client,
+    ):
+        channels = advertised(client)
+        for index in range(sent):
+            client.send(frames[index % len(frames)])
+            if index % 100 == 99:  # read its status replies, or it drops a client too slow
+                message_data(client, 0.01)
+        # The server reads a client's frames in order: data on this subscription means it has
+        # read (and logged about) every bad frame before it.
+        subscribe = {"id": 7, "channelId": channels[TOPIC_RECORD]["id"]}
+        client.send(json.dumps({"op": "subscribe", "subscriptions": [subscribe]}))
+        received: list[tuple[int, int, bytes]] = []
+        for record, frame in RECORDS:
+            recorder.on_record(record, frame)
+            received += message_data(client, 0.05)
+            if received:
+                break
+        assert received and received[0][0] == 7
+    recorder.close()
+    about_client = [r.getMessage() for r in caplog.records if "127.0.0.1:" in r.getMessage()]
+    assert len(about_client) == 1 and about_client[0].startswith("Invalid message from 127.0.0.1")
+    summary = [r.getMessage() for r in caplog.records if "held back" in r.getMessage()]
+    assert summary == [
+        f"foxglove: {sent - 1} more lines about client 127.0.0.1 held back ({sent} in all: bad "
+        "frames from it)"
+    ]

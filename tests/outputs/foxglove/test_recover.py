@@ -23,7 +23,7 @@ from roadgaze.config import Config, RecordConfig
 from roadgaze.errors import RoadgazeError
 from roadgaze.outputs.foxglove.channels import TOPIC_RECORD, TOPIC_STATE
 from roadgaze.outputs.foxglove.open import replay_recorder
-from roadgaze.outputs.foxglove.recover import recover_mcap
+from roadgaze.outputs.foxglove.recover import recover_mcap, recover_parts
 from zenoh_helpers import endpoint, free_port, stop_process, wait_for
 
 FAKE_DAEMON = REPO / "tests" / "fake_daemon.py"
@@ -165,6 +165,50 @@ def test_the_recover_command(
     whole = tmp_path / "drive.mcap"
     assert main(["recover", str(whole), "--out", str(whole)]) == 2
     assert "is the input (FILE)" in capsys.readouterr().err
+
+
+def test_recover_never_overwrites_another_recording(
+    complete: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], restore_logging: None
+) -> None:
+    """`X.mcap.part` beside another, different `X.mcap`: the recovery takes the next free name
+    (said in one warning), again and again; an --out that exists is refused in one line."""
+    data = complete.read_bytes()
+    part = tmp_path / "X.mcap.part"
+    part.write_bytes(data[: len(data) // 2])
+    other = tmp_path / "X.mcap"
+    other.write_bytes(b"another recording, kept byte for byte")
+    assert main(["recover", str(part)]) == 0
+    err = capsys.readouterr().err
+    assert f"{other} exists (another file, never overwritten): wrote {tmp_path / 'X-1.mcap'}" in err
+    assert other.read_bytes() == b"another recording, kept byte for byte"
+    assert sum(read_mcap(tmp_path / "X-1.mcap").counts.values()) > 0
+    assert main(["recover", str(part)]) == 0
+    assert (tmp_path / "X-2.mcap").read_bytes() == (tmp_path / "X-1.mcap").read_bytes()
+    capsys.readouterr()
+    assert main(["recover", str(part), "--out", str(other)]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"roadgaze recover: error: {other} exists; recover never overwrites a file: remove it "
+        "or choose another --out"
+    ]
+    assert other.read_bytes() == b"another recording, kept byte for byte"
+    assert sorted(path.name for path in tmp_path.iterdir()) == [
+        "X-1.mcap",
+        "X-2.mcap",
+        "X.mcap",
+        "X.mcap.part",
+    ]
+
+
+def test_run_record_recovers_a_part_beside_a_closed_segment_of_its_name(
+    complete: Path, tmp_path: Path
+) -> None:
+    data = complete.read_bytes()
+    (tmp_path / "seg-1.mcap.part").write_bytes(data[: len(data) // 2])
+    (tmp_path / "seg-1.mcap").write_bytes(data)
+    (recovery,) = recover_parts(tmp_path, "seg-*.mcap.part")
+    assert recovery.path == tmp_path / "seg-1-1.mcap"
+    assert (tmp_path / "seg-1.mcap").read_bytes() == data
+    assert not (tmp_path / "seg-1.mcap.part").exists()
 
 
 def test_the_mcap_source_reads_a_cut_file_up_to_its_last_chunk(

@@ -1,17 +1,22 @@
 """`run --record DIR`'s segments: rotated by size and by age, every closed one complete and
-readable, the folder kept under its bound by removing the oldest first (logged), and a part a
-killed run left recovered when the folder is opened again."""
+readable, the folder kept under its bound by removing the oldest first (logged), a part a
+killed run left recovered when the folder is opened again, and a live run's segments never
+taken over by another run (the prefix lock)."""
 
 from __future__ import annotations
 
 import logging
+import os
 import shutil
+import subprocess
+import sys
 import time
 from pathlib import Path
 
 import pytest
 
 from foxglove_helpers import pipeline_records, read_mcap
+from repo_paths import child_env
 from roadgaze.config import Config, RecordConfig, load_config
 from roadgaze.errors import ConfigError
 from roadgaze.outputs.foxglove.channels import TOPIC_RECORD
@@ -139,3 +144,83 @@ def test_copying_a_closed_segment_elsewhere_keeps_it_readable(tmp_path: Path) ->
     copy = tmp_path / "copy.mcap"
     shutil.copy(segments.closed[0], copy)
     assert frames_in(copy) == list(range(len(RECORDS)))
+
+
+def test_a_second_run_with_the_same_vehicle_id_never_takes_over_the_first_ones_segment(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Issue 34: a second `run --record` with the same vehicle id took the first one's open
+    segment for one 'left open by an interrupted run': the first recording stopped with an
+    error and the rest of its drive was never recorded. The second records as PREFIX.2 now."""
+    settings = RecordConfig(flush_s=0.05, images=False)
+    first = McapSegments(tmp_path, settings, False, PREFIX)
+    recorder = FoxgloveRecorder(
+        [first], Config(record=settings), images=False, source="first", wall_clock_stamps=True
+    )
+    with recorder:
+        for sample, frame in RECORDS[:100]:
+            recorder.on_record(sample, frame)
+        time.sleep(0.2)  # flushed: a part with complete chunks, as a live run's is
+        with caplog.at_level(logging.WARNING, logger="roadgaze"):
+            second = record_slowly(tmp_path, settings, frame_s=0.0)
+        for sample, frame in RECORDS[100:]:
+            recorder.on_record(sample, frame)
+    assert recorder.failure is None
+    (own,) = first.closed
+    assert frames_in(own) == list(range(len(RECORDS)))  # every frame of the first drive
+    (other,) = second.closed
+    assert second.prefix == f"{PREFIX}.2" and other.name.startswith(f"{PREFIX}.2-")
+    assert frames_in(other) == list(range(len(RECORDS)))
+    said = [r.getMessage() for r in caplog.records]
+    assert not any("recovered" in line for line in said)
+    assert any(f"another run (pid {os.getpid()}) is recording {PREFIX}'s" in line for line in said)
+    assert first.segments_on_disk() == [own]  # each run's own segments only
+
+
+def test_a_run_in_another_process_holds_its_prefix_until_it_ends(tmp_path: Path) -> None:
+    from roadgaze.outputs.foxglove.segment_lock import claim_prefix, recording_pid
+
+    holder = subprocess.Popen(
+        [sys.executable, "-c",
+         "import sys, pathlib; from roadgaze.outputs.foxglove.segment_lock import claim_prefix;"
+         f"lock = claim_prefix(pathlib.Path({str(tmp_path)!r}), {PREFIX!r}); print('held', "
+         "flush=True); sys.stdin.readline()"],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=child_env(),
+    )  # fmt: skip
+    try:
+        assert holder.stdout is not None and holder.stdout.readline() == "held\n"
+        part = tmp_path / f"{PREFIX}-20260101T000000Z-0001.mcap.part"
+        assert recording_pid(part) == holder.pid
+        lock, name = claim_prefix(tmp_path, PREFIX)
+        assert name == f"{PREFIX}.2"
+        lock.release()
+    finally:
+        holder.kill()  # however a run ends, its lock goes with it
+        holder.wait(timeout=10)
+    assert recording_pid(part) is None
+    lock, name = claim_prefix(tmp_path, PREFIX)
+    assert name == PREFIX
+    lock.release()
+
+
+def test_another_vehicles_segments_are_never_taken_for_this_ones(tmp_path: Path) -> None:
+    """`roadgaze-car-*` also named car-0's files: vehicle `car` would recover car-0's open
+    segment and remove its closed ones to make room."""
+    longer = tmp_path / "roadgaze-car-0-20260101T000000Z-0001.mcap"
+    longer.write_bytes(b"car-0's" * 10_000)
+    longer_part = tmp_path / "roadgaze-car-0-20260101T000000Z-0002.mcap.part"
+    longer_part.write_bytes(b"car-0's open segment")
+    settings = RecordConfig(
+        segment_mb=0.06, max_disk_mb=0.15, flush_s=0.05, image_fps=30.0, images=True
+    )
+    config = Config(record=settings)
+    segments = McapSegments(tmp_path, settings, True, "roadgaze-car")
+    with FoxgloveRecorder(
+        [segments], config, images=True, source="car", wall_clock_stamps=True,
+        block_on_images=True,
+    ) as recorder:  # fmt: skip
+        for sample, frame in RECORDS:
+            recorder.on_record(sample, frame)
+            time.sleep(0.004)
+    assert segments.removed  # it did make room, from its own segments only
+    assert longer.exists() and longer_part.read_bytes() == b"car-0's open segment"

@@ -48,7 +48,12 @@ class Tracking(Protocol):
     later needs). The loop measures faces on another thread than it infers them, so `complete`
     runs there, in parallel with `track` on the next frame (the LiteRT engine)."""
 
-    def track(self, image: Any, timestamp_ms: int | None) -> list[npt.NDArray[np.float32]]: ...
+    def track(
+        self, image: Any, timestamp_ms: int | None, retry_rejected: bool = False
+    ) -> list[npt.NDArray[np.float32]]:
+        """`retry_rejected`: look again at a face the landmark model rejected (the LiteRT
+        engine's second looks)."""
+        ...
 
     def complete(
         self, points: npt.NDArray[np.float32], size: tuple[int, int]

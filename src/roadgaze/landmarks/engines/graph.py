@@ -19,6 +19,9 @@ height (x right, y down), rotations in radians, positive clockwise on the image 
   its regions replace tracked ones that overlap them (IoU > `min_tracking_confidence`).
 - **Smoothing** (VIDEO mode, one face): a one-euro filter per coordinate (min cutoff 0.05,
   beta 80, derivative cutoff 1) on pixel coordinates, velocities scaled by the face size.
+- **Mirrored crop** (roadgaze's own, not MediaPipe's): the landmarks the model finds in a crop
+  flipped left to right, put back (`unmirror_landmarks`: x flipped, each landmark renumbered as
+  its mirror image, `mirror_order`).
 """
 
 from __future__ import annotations
@@ -49,6 +52,11 @@ ONE_EURO_DERIVATIVE_CUTOFF = 1.0
 ONE_EURO_FREQUENCY = 30.0
 """The filter's rate (Hz) until two timestamps after time 0 give it one (the option's default)."""
 FLOAT_MIN = float(np.finfo(np.float32).tiny)
+IRIS_MIRROR = (473, 476, 475, 474, 477, 468, 471, 470, 469, 472)
+"""The mirror images of the iris landmarks 468-477 (each iris's centre, then its four points;
+matched on the landmark model's output for a face and its flipped crop, within 0.7 px)."""
+MIRROR_TOLERANCE = 1e-3
+"""How far (canonical face units, cm) a vertex's mirror image may lie from its partner."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -258,6 +266,31 @@ def project_landmarks(
     out[:, 1] = (a * d * x + b * c * y + (-0.5 * b * c - 0.5 * a * d + f)) / size[1]
     out[:, 2] = points[:, 2] * math.hypot(a * c / size[0], a * d / size[1])
     return out.astype(np.float32)
+
+
+def mirror_order(canonical: npt.NDArray[np.floating]) -> npt.NDArray[np.intp]:
+    """(478,) the index of each landmark's mirror image (the face's left and right swapped): the
+    mesh's from the canonical face's (3, 468) vertices, which are symmetric about x = 0, and the
+    irises' (`IRIS_MIRROR`). ValueError when the canonical face is not symmetric."""
+    points = np.asarray(canonical, np.float64).T
+    mirrored = points * np.array([-1.0, 1.0, 1.0])
+    distances = np.linalg.norm(points[:, None, :] - mirrored[None, :, :], axis=2)
+    order = distances.argmin(axis=1)
+    paired = np.array_equal(order[order], np.arange(order.size))
+    if distances.min(axis=1).max() > MIRROR_TOLERANCE or not paired:
+        raise ValueError("the canonical face is not mirror-symmetric")
+    return np.concatenate([order, np.asarray(IRIS_MIRROR, np.intp)]).astype(np.intp)
+
+
+def unmirror_landmarks(
+    raw: npt.NDArray[np.float32], input_size_px: int, order: npt.NDArray[np.intp]
+) -> npt.NDArray[np.float32]:
+    """The model's raw landmarks (input pixels, x, y, z) of a crop flipped left to right, as
+    landmarks of the crop itself: x mirrored about the crop's middle and each landmark taken from
+    its mirror image (z, depth, unchanged)."""
+    points = raw.reshape(-1, 3)[order]
+    points[:, 0] = np.float32(input_size_px) - points[:, 0]
+    return points
 
 
 def associate(tracked: list[Rect], detected: list[Rect], min_iou: float) -> list[Rect]:

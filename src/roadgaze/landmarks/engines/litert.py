@@ -10,6 +10,9 @@ with one face the one-euro smoothing, the blendshapes from their 146 landmarks a
 transformation matrix from the canonical face (`roadgaze.landmarks.engines.geometry`). The rules
 are `roadgaze.landmarks.engines.graph`.
 
+With `retry_rejected` (the front end's, on dark and flat frames) a face the landmark model
+rejects gets three more looks, roadgaze's own (`_landmarks_in`, docs/conditions.md).
+
 `threads` sets LiteRT's thread count (1 by default: a worker per core scales, and a second thread
 was slower on a loaded 2-core machine). `delegate` is `xnnpack` (LiteRT's default CPU kernels),
 `none` (its reference-free builtin kernels without delegates) or the path of a delegate library
@@ -64,6 +67,8 @@ BLENDSHAPE_NAMES = (
     "mouthStretchLeft", "mouthStretchRight", "mouthUpperUpLeft", "mouthUpperUpRight",
     "noseSneerLeft", "noseSneerRight",
 )  # fmt: skip
+RETRY_LOOKS = ((False, False), (True, False), (False, True), (True, False))
+"""(re-cut from the last look's landmarks, mirrored) of each look at a face (`_landmarks_in`)."""
 DELEGATES = ("xnnpack", "none")
 """Named delegates; anything else is the path of a delegate library."""
 
@@ -279,6 +284,7 @@ class LiteRtFaceLandmarker:
         self._detector, self._landmarks = models.detector, models.landmarks
         self._blendshapes = models.blendshapes
         self._face = bundle.face
+        self._mirror = graph.mirror_order(bundle.face.points)  # ValueError: not a face
         self._warper = Warper(LANDMARKS_SIZE, cv2.BORDER_REPLICATE)
         self._num_faces = num_faces
         self._video = video
@@ -291,7 +297,7 @@ class LiteRtFaceLandmarker:
         return [(points, *self.complete(points, size)) for points in self.track(rgb, timestamp_ms)]
 
     def track(
-        self, rgb: npt.NDArray[np.uint8], timestamp_ms: int | None
+        self, rgb: npt.NDArray[np.uint8], timestamp_ms: int | None, retry_rejected: bool = False
     ) -> list[npt.NDArray[np.float32]]:
         """The normalised landmarks of the faces in the RGB image: the part of `run` the next
         frame depends on (regions, tracking, smoothing); `complete` gives the rest."""
@@ -304,13 +310,9 @@ class LiteRtFaceLandmarker:
         faces: list[npt.NDArray[np.float32]] = []
         tracked: list[graph.Rect] = []
         for rect in rects[: self._num_faces]:
-            roi = graph.roi_pixels(rect, size)
-            warped = self._warper.warp(rgb, roi)
-            outputs = self._landmarks.run(warped, 1.0 / 255.0)
-            presence = 1.0 / (1.0 + np.exp(-float(outputs[1].reshape(-1)[0])))
-            if presence <= self._settings.min_presence_confidence:
+            points = self._landmarks_in(rgb, rect, size, retry_rejected)
+            if points is None:
                 continue
-            points = graph.project_landmarks(outputs[0], LANDMARKS_SIZE, rect, size)
             faces.append(points)
             tracked.append(graph.landmarks_rect(points, size))
         self._tracked = tracked
@@ -322,6 +324,27 @@ class LiteRtFaceLandmarker:
             else:
                 self._smoother.reset()
         return faces
+
+    def _landmarks_in(
+        self, rgb: npt.NDArray[np.uint8], rect: graph.Rect, size: tuple[int, int], retry: bool
+    ) -> npt.NDArray[np.float32] | None:
+        """The normalised landmarks of the face in `rect`, None when the landmark model rejects
+        it (presence <= `min_presence_confidence`). With `retry`, three more looks at a rejected
+        face: the region re-cut from its landmarks (as tracking cuts the next frame's), the first
+        crop mirrored (a second opinion: the model is not mirror-symmetric), and re-cut again."""
+        points = None
+        for recut, mirrored in RETRY_LOOKS if retry else RETRY_LOOKS[:1]:
+            region = graph.landmarks_rect(points, size) if recut and points is not None else rect
+            warped = self._warper.warp(rgb, graph.roi_pixels(region, size))
+            outputs = self._landmarks.run(warped[:, ::-1] if mirrored else warped, 1.0 / 255.0)
+            raw = outputs[0]
+            if mirrored:
+                raw = graph.unmirror_landmarks(raw, LANDMARKS_SIZE, self._mirror)
+            points = graph.project_landmarks(raw, LANDMARKS_SIZE, region, size)
+            presence = 1.0 / (1.0 + np.exp(-float(outputs[1].reshape(-1)[0])))
+            if presence > self._settings.min_presence_confidence:
+                return points
+        return None
 
     def complete(
         self, points: npt.NDArray[np.float32], size: tuple[int, int]

@@ -1,34 +1,90 @@
-"""The protocols the monitor warns by, as tables of rules (one module each). Pure.
+"""The protocols the monitor warns by: their rules (one module each) and the table of behaviours
+they run. Pure.
 
 `[monitor] protocol` picks `addw` (EU 2023/2590), `euroncap` (Euro NCAP driver state monitoring)
-or `both` (default: the earlier warning of the two). The state machine
-(`roadgaze.monitor.inattention`) asks this module when a distraction warning is due at the
-current speed and which rule an alert fired by; every rule names its `[monitor]` setting, unit
-and source (docs/monitor.md, "Protocols").
+or `both` (default: the earlier warning of the two). `TABLE` says which behaviours run
+(roadgaze.monitor.behaviours), with which rules, for which protocol, in the order they run;
+`distraction_trigger` says when the configured protocols ask for a distraction warning at the
+current speed. Every rule names its `[monitor]` setting, unit and source (docs/monitor.md,
+"Protocols").
 """
 
 from __future__ import annotations
 
+from functools import cache
+from typing import Any
+
 from roadgaze.config import MonitorConfig
+from roadgaze.monitor.behaviours import (
+    Clearing,
+    Degraded,
+    Distraction,
+    Drowsy,
+    EyeClosure,
+    TemporaryFailure,
+    Unavailable,
+    Unresponsive,
+    Vats,
+)
+from roadgaze.monitor.context import Behaviour
+from roadgaze.monitor.events import Rule, Trigger
 from roadgaze.monitor.protocols import addw, euroncap, roadgaze
-from roadgaze.monitor.protocols.rules import Rule, Trigger
-from roadgaze.types import AlertKind, AlertLevel
 
 __all__ = [
     "ALL_RULES",
+    "TABLE",
     "Rule",
     "Trigger",
     "addw",
+    "behaviours",
+    "configured",
     "distraction_trigger",
     "euroncap",
     "moving_at",
     "roadgaze",
-    "rule_of",
     "uses",
 ]
 
 ALL_RULES: tuple[Rule, ...] = (*addw.RULES, *euroncap.RULES, *roadgaze.RULES)
 """Every rule, for the documentation's table and conformance reports."""
+
+TABLE: tuple[tuple[str, Behaviour[Any]], ...] = (
+    ("roadgaze", Distraction(critical=roadgaze.CRITICAL)),
+    ("euroncap", Vats(euroncap.VATS, rearm=euroncap.VATS_REARM)),
+    ("roadgaze", Unavailable(roadgaze.UNAVAILABLE)),
+    ("roadgaze", EyeClosure(euroncap.MICROSLEEP, euroncap.SLEEP, euroncap.UNRESPONSIVE_CLOSED)),
+    ("roadgaze", Drowsy(roadgaze.DROWSY)),
+    ("roadgaze", Degraded(euroncap.IMPAIRED)),
+    ("euroncap", Unresponsive(euroncap.UNRESPONSIVE_AWAY, euroncap.UNRESPONSIVE_AFTER_WARNING)),
+    (
+        "roadgaze",
+        TemporaryFailure(
+            frames=addw.FAILURE_TEMPORARY,
+            frozen=roadgaze.FROZEN,
+            no_face=roadgaze.NO_FACE,
+            eyes=addw.FAILURE_TEMPORARY,
+            eyes_needed_by="euroncap",
+        ),
+    ),
+    ("roadgaze", Clearing(roadgaze.CLEAR)),
+)
+"""Which behaviour runs for which protocol, configured with which rules, in the order they run
+(a sample's alerts come in this order; a behaviour sees the events of those before it). The
+`roadgaze` rows run under every protocol: the long distraction's warning time comes from the
+configured protocols' triggers (`distraction_trigger`), the eye rules cite Euro NCAP's rows."""
+
+
+@cache
+def configured(protocol: str) -> frozenset[str]:
+    """The protocols `[monitor] protocol` (`addw`, `euroncap` or `both`) stands for."""
+    return frozenset({"addw", "euroncap"} if protocol == "both" else {protocol})
+
+
+@cache
+def behaviours(protocol: str) -> tuple[Behaviour[Any], ...]:
+    """The behaviours `[monitor] protocol` runs, in order."""
+    protocols = configured(protocol)
+    return tuple(b for owner, b in TABLE if owner == "roadgaze" or owner in protocols)
 
 
 def uses(config: MonitorConfig, protocol: str) -> bool:
@@ -58,38 +114,3 @@ def distraction_trigger(
         triggers.append(addw.distraction_trigger(config, speed_kmh, non_nominal))
     due = [t for t in triggers if t is not None]
     return min(due, key=lambda t: t.warn_s) if due else None
-
-
-def rule_of(kind: AlertKind, level: AlertLevel, reason: str) -> Rule | None:
-    """The rule an alert other than a long-distraction warning fired by."""
-    if kind is AlertKind.LONG_DISTRACTION and level is AlertLevel.CRITICAL:
-        return roadgaze.CRITICAL
-    by_reason = _BY_REASON.get(kind)
-    if by_reason is not None:
-        return next((rule for start, rule in by_reason if reason.startswith(start)), None)
-    return _BY_KIND.get(kind)
-
-
-_BY_REASON: dict[AlertKind, tuple[tuple[str, Rule], ...]] = {
-    AlertKind.UNRESPONSIVE: (
-        ("eyes closed", euroncap.UNRESPONSIVE_CLOSED),
-        ("away", euroncap.UNRESPONSIVE_AWAY),
-        ("", euroncap.UNRESPONSIVE_AFTER_WARNING),
-    ),
-    AlertKind.TEMPORARY_FAILURE: (
-        ("frames frozen", roadgaze.FROZEN),
-        ("no face", roadgaze.NO_FACE),
-        ("", addw.FAILURE_TEMPORARY),
-    ),
-}
-"""Kinds whose rule depends on the reason: the first prefix that matches."""
-_BY_KIND: dict[AlertKind, Rule] = {
-    AlertKind.VATS: euroncap.VATS,
-    AlertKind.DRIVER_UNAVAILABLE: roadgaze.UNAVAILABLE,
-    AlertKind.MICROSLEEP: euroncap.MICROSLEEP,
-    AlertKind.SLEEP: euroncap.SLEEP,
-    AlertKind.DROWSY: roadgaze.DROWSY,
-    AlertKind.DEGRADED: euroncap.IMPAIRED,
-    AlertKind.PERMANENT_FAILURE: addw.FAILURE_PERMANENT,
-    AlertKind.CLEARED: roadgaze.CLEAR,
-}

@@ -9,7 +9,7 @@ warning triggers in Annex I 3.3.2 and the failure warnings in 3.5). Each rule's 
 from __future__ import annotations
 
 from roadgaze.config import MonitorConfig
-from roadgaze.monitor.protocols.rules import Rule, Trigger
+from roadgaze.monitor.events import Rule, Trigger
 
 __all__ = [
     "ACTIVE",

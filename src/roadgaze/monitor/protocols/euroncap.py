@@ -10,7 +10,7 @@ here). The protocol's lowest operating speed was not found in a readable source:
 from __future__ import annotations
 
 from roadgaze.config import MonitorConfig
-from roadgaze.monitor.protocols.rules import Rule, Trigger
+from roadgaze.monitor.events import Rule, Trigger
 
 __all__ = [
     "ACTIVE",

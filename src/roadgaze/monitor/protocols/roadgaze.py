@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from roadgaze.monitor.protocols.rules import Rule
+from roadgaze.monitor.events import Rule
 
 __all__ = [
     "CLEAR",

@@ -22,6 +22,8 @@ from collections.abc import Iterable
 from typing import Any
 
 import foxglove
+import numpy as np
+import numpy.typing as npt
 from foxglove.channels import CompressedImageChannel, ImageAnnotationsChannel, LogChannel
 from foxglove.messages import (
     Color,
@@ -43,11 +45,12 @@ from roadgaze.capture.mcap_driver import (
     driver_message,
 )
 from roadgaze.config import MonitorConfig
+from roadgaze.errors import RoadgazeError
 from roadgaze.outputs.annotate import face_lines_px, verdict_text
 from roadgaze.outputs.plots import road_bands_deg, road_pitch_bands_deg, timer_thresholds
 from roadgaze.outputs.records import RECORD_SCHEMA, FieldType, record_fields, rounded
 from roadgaze.transport.messages import AlertMessage, StateMessage
-from roadgaze.types import FrameRecord
+from roadgaze.types import Alert, FrameRecord
 
 TOPIC_IMAGE = "/camera/image"
 TOPIC_ANNOTATIONS = "/roadgaze/annotations"
@@ -301,11 +304,13 @@ class FrameChannels:
             annotations = face_annotations(record, stamp_ns, scale, with_landmarks)
             self.annotations.log(annotations, log_time=stamp_ns)
         for alert in record.alerts:
-            message = AlertMessage.from_alert(
-                alert, self.vehicle_id, self.alerts_logged, wall_time_s
-            )
-            self.alerts.log(message.to_json_bytes(), log_time=stamp_ns)
-            self.alerts_logged += 1
+            self.log_alert(alert, stamp_ns, wall_time_s)
+
+    def log_alert(self, alert: Alert, stamp_ns: int, wall_time_s: float) -> None:
+        """One alert on the alerts channel (of a frame, or raised outside the loop)."""
+        message = AlertMessage.from_alert(alert, self.vehicle_id, self.alerts_logged, wall_time_s)
+        self.alerts.log(message.to_json_bytes(), log_time=stamp_ns)
+        self.alerts_logged += 1
 
     def log_image(self, data: bytes, image_format: str, stamp_ns: int) -> None:
         message = CompressedImage(
@@ -340,6 +345,25 @@ class FrameChannels:
             line=entry.lineno,
         )
         self.log.log(line, log_time=stamp_ns)
+
+
+def encode_image(
+    image: npt.NDArray[np.uint8], width_px: int, image_format: str, jpeg_quality: int
+) -> bytes:
+    """`image` (BGR) scaled down to `width_px` wide if wider, as JPEG or PNG bytes."""
+    import cv2
+
+    height, width = image.shape[:2]
+    if width > width_px:
+        size = scaled_size(width, height, width_px)
+        image = np.asarray(cv2.resize(image, size, interpolation=cv2.INTER_AREA), np.uint8)
+    if image_format == "png":
+        ok, data = cv2.imencode(".png", image, [cv2.IMWRITE_PNG_COMPRESSION, 1])
+    else:
+        ok, data = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, jpeg_quality])
+    if not ok:
+        raise RoadgazeError(f"cannot encode a {width}x{height} camera frame as {image_format}")
+    return bytes(data)
 
 
 _ENCODER = json.JSONEncoder(allow_nan=False, separators=(",", ":"))

@@ -5,12 +5,18 @@ on the recorder's context: a client (the Foxglove app, `docs/foxglove.md`) is to
 (`advertise`), subscribes to those it shows and receives each message as it is logged. Camera
 frames are encoded only while a client is subscribed to them. The server binds to loopback
 unless told otherwise; bound elsewhere it warns, since the stream shows the driver's face.
+
+The SDK logs one error line per bad frame a client sends (a hostile client made 36,150 in
+45 s): a `ClientLogThrottle` lets, per client host, the first line through at once and then
+one per 10 s saying how many were held back; the count still held back is logged when the
+server stops.
 """
 
 from __future__ import annotations
 
 import ipaddress
 import logging
+import re
 import threading
 
 import foxglove
@@ -18,6 +24,7 @@ from foxglove.websocket import ChannelView, Client, ServerListener, WebSocketSer
 
 from roadgaze.errors import ConfigError
 from roadgaze.outputs.foxglove.channels import TOPIC_IMAGE
+from roadgaze.transport.throttle import KeyedThrottle
 
 log = logging.getLogger(__name__)
 
@@ -54,6 +61,51 @@ def is_loopback(host: str) -> bool:
         return False
 
 
+CLIENT_LOGGERS = ("foxglove.websocket.connected_client", "foxglove.websocket.server")
+"""The SDK's loggers that write a line per message (or connection) of a client."""
+_CLIENT_ADDRESS = re.compile(r"(?P<host>\[[0-9A-Fa-f:.]+\]|\d{1,3}(?:\.\d{1,3}){3}):\d+")
+
+
+class ClientLogThrottle(logging.Filter):
+    """A filter on the SDK's client loggers: per client host (the address in the line), the
+    first warning or error at once, then at most one per `period_s` with how many were held
+    back. Lines that name no client, and debug lines, pass unchanged."""
+
+    def __init__(self, period_s: float = 10.0) -> None:
+        super().__init__()
+        self.throttle = KeyedThrottle(period_s)
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.levelno < logging.WARNING:
+            return True
+        text = record.getMessage()
+        found = _CLIENT_ADDRESS.search(text)
+        if found is None:
+            return True
+        client = found.group("host")
+        passed = self.throttle(client)
+        if passed is None:
+            return False
+        held_back, total = passed
+        if held_back:
+            record.msg = (
+                f"{text} ({held_back} more lines about client {client} held back since the "
+                f"last, {total} in all)"
+            )
+            record.args = ()
+        return True
+
+    def report(self) -> None:
+        """Log how many lines about each client are still held back (at the server's stop)."""
+        for client, (held_back, total) in self.throttle.held_back().items():
+            log.warning(
+                "foxglove: %d more lines about client %s held back (%d in all: bad frames from it)",
+                held_back,
+                client,
+                total,
+            )
+
+
 class _Subscriptions(ServerListener):
     """The server's listener: how many clients are subscribed to the camera frames."""
 
@@ -84,6 +136,7 @@ class LiveServer:
         self.images = images
         self._subscriptions = _Subscriptions()
         self._server: WebSocketServer | None = None
+        self.client_logs = ClientLogThrottle()
 
     @property
     def port(self) -> int:
@@ -95,6 +148,8 @@ class LiveServer:
         return f"ws://{host}:{self.port}"
 
     def open(self, context: foxglove.Context) -> None:
+        for name in CLIENT_LOGGERS:
+            logging.getLogger(name).addFilter(self.client_logs)
         try:
             self._server = foxglove.start_server(
                 name=SERVER_NAME,
@@ -107,6 +162,7 @@ class LiveServer:
                 else (lambda channel: channel.topic != TOPIC_IMAGE),
             )
         except (OSError, RuntimeError) as exc:
+            self._stop_filtering()
             raise ConfigError(
                 f"cannot serve the Foxglove live view on {self.host}:{self.requested_port}: {exc}"
             ) from None
@@ -135,3 +191,9 @@ class LiveServer:
         server, self._server = self._server, None
         if server is not None:
             server.stop()
+            self._stop_filtering()
+            self.client_logs.report()
+
+    def _stop_filtering(self) -> None:
+        for name in CLIENT_LOGGERS:
+            logging.getLogger(name).removeFilter(self.client_logs)

@@ -11,6 +11,11 @@ from roadgaze.outputs.foxglove.recorder import FoxgloveRecorder
 from roadgaze.outputs.foxglove.targets import McapFile, McapSegments, Target
 
 
+def segment_prefix(config: Config) -> str:
+    """The names of the vehicle's segments start with this (`roadgaze-car-0`)."""
+    return f"roadgaze-{config.zenoh.vehicle_id}"
+
+
 def replay_recorder(
     config: Config,
     source: str,
@@ -46,7 +51,7 @@ def vehicle_recorder(
     targets: list[Target] = []
     settings = config.record
     if folder is not None:
-        prefix = f"roadgaze-{config.zenoh.vehicle_id}"
+        prefix = segment_prefix(config)
         targets.append(McapSegments(folder, settings, settings.images_for("vehicle"), prefix))
     if live_address is not None:
         host, port = parse_address(live_address)

@@ -34,9 +34,9 @@ import numpy.typing as npt
 from roadgaze import __version__
 from roadgaze.config import Config
 from roadgaze.errors import RoadgazeError
-from roadgaze.outputs.foxglove.channels import FrameChannels, scaled_size
+from roadgaze.outputs.foxglove.channels import FrameChannels, encode_image
 from roadgaze.outputs.foxglove.targets import Target
-from roadgaze.types import ClosesOnExit, Frame, FrameRecord
+from roadgaze.types import Alert, ClosesOnExit, Frame, FrameRecord, Sink
 
 log = logging.getLogger(__name__)
 
@@ -61,6 +61,12 @@ class _FrameItem:
 
 
 @dataclass(frozen=True, slots=True)
+class _AlertItem:
+    alert: Alert
+    stamp_ns: int
+
+
+@dataclass(frozen=True, slots=True)
 class _LogItem:
     entry: logging.LogRecord
     message: str
@@ -79,26 +85,7 @@ class _LogTap(logging.Handler):
         self._recorder.queue_log(record)
 
 
-def encode_image(
-    image: npt.NDArray[np.uint8], width_px: int, image_format: str, jpeg_quality: int
-) -> bytes:
-    """`image` (BGR) scaled down to `width_px` wide if wider, as JPEG or PNG bytes."""
-    import cv2
-
-    height, width = image.shape[:2]
-    if width > width_px:
-        size = scaled_size(width, height, width_px)
-        image = np.asarray(cv2.resize(image, size, interpolation=cv2.INTER_AREA), np.uint8)
-    if image_format == "png":
-        ok, data = cv2.imencode(".png", image, [cv2.IMWRITE_PNG_COMPRESSION, 1])
-    else:
-        ok, data = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, jpeg_quality])
-    if not ok:
-        raise RoadgazeError(f"cannot encode a {width}x{height} camera frame as {image_format}")
-    return bytes(data)
-
-
-class FoxgloveRecorder(ClosesOnExit):
+class FoxgloveRecorder(ClosesOnExit, Sink):
     """Pipeline sink: each record to `targets` (see the module doc). A context manager.
 
     `images`: take camera frames at all (each target still says whether it wants them now).
@@ -188,6 +175,13 @@ class FoxgloveRecorder(ClosesOnExit):
             with_image = self._put_image(frame.image, stamp_ns, record)
         self._put(self._records, _FrameItem(record, stamp_ns, frame.image.shape[1], with_image))
         self.records_queued += 1
+
+    def on_alert(self, alert: Alert) -> None:
+        """An alert raised outside the frame loop, on the alerts channel: stamped now (wall
+        clock), or at its time on the source's timeline."""
+        offset_ns = self._offset_ns or 0
+        stamp_ns = time.time_ns() if self._wall_clock_stamps else offset_ns + round(alert.t_s * 1e9)
+        self._put(self._records, _AlertItem(alert, max(0, stamp_ns)))
 
     def _start(self, t_s: float) -> int:
         """At the first frame: the time offset, and the metadata that carries it written ahead
@@ -311,6 +305,9 @@ class FoxgloveRecorder(ClosesOnExit):
         if isinstance(item, _LogItem):
             self._channels.log_line(item.entry, item.message, item.stamp_ns)
             return
+        if isinstance(item, _AlertItem):
+            self._channels.log_alert(item.alert, item.stamp_ns, time.time())
+            return
         self._write_frame(item)
         if self._state is not None and item.stamp_ns >= self._next_state_ns:
             self._channels.log_state(self._state(), item.stamp_ns)
@@ -326,7 +323,7 @@ class FoxgloveRecorder(ClosesOnExit):
         self.records_written += 1
 
     def _image_loop(self) -> None:
-        from roadgaze.pipeline.steps import lower_this_thread_priority
+        from roadgaze.threads import lower_this_thread_priority
 
         lower_this_thread_priority(IMAGE_NICENESS)
         started_cpu_s = time.thread_time()

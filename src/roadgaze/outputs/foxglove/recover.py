@@ -7,6 +7,10 @@ order with the `mcap` reader until the first one that is incomplete or fails its
 writes what it read into a new, indexed file: every message of every complete chunk is kept;
 lost are the chunk that was being written (at most `record.flush_s` of data: the writer writes
 and syncs its open chunk that often) and anything after a damaged record.
+
+A recovery never overwrites a file: the recovered recording takes its name only if that name is
+free at the moment it is placed (a hard link, which fails on an existing name), else the next
+free `NAME-1.mcap`, `NAME-2.mcap`, ... (or, asked for one exact name, it is refused).
 """
 
 from __future__ import annotations
@@ -19,9 +23,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mcap.records import Channel, Chunk, Header, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType, Writer
 
+from roadgaze.capture.mcap import MCAP_MAGIC
+from roadgaze.capture.mcap_records import (
+    DEFAULT_MAX_CHUNK_MIB,
+    ChunkTooLargeError,
+    max_chunk_bytes,
+    top_level_records,
+)
 from roadgaze.errors import RoadgazeError
 from roadgaze.outputs.foxglove.targets import OPEN_SUFFIX
 
@@ -60,31 +70,23 @@ class Recovery:
         )
 
 
-class _Counting:
-    """A binary stream that counts what was read (where the last good record ended)."""
-
-    def __init__(self, stream: object) -> None:
-        self._stream = stream
-        self.position = 0
-
-    def read(self, size: int = -1) -> bytes:
-        data: bytes = self._stream.read(size)  # type: ignore[attr-defined]
-        self.position += len(data)
-        return data
-
-
-def _records(stream: _Counting) -> Iterator[tuple[object, int]]:
-    """(record, end offset) of each record read in order; stops at the first unreadable one by
-    raising it to the caller."""
-    reader = StreamReader(stream, skip_magic=False, emit_chunks=True)  # type: ignore[arg-type]
-    for record in reader.records:
-        yield record, stream.position
-
-
-def recover_mcap(source: Path, path: Path) -> Recovery:
+def recover_mcap(
+    source: Path,
+    path: Path,
+    *,
+    exact: bool = False,
+    max_chunk_mib: float = DEFAULT_MAX_CHUNK_MIB,
+) -> Recovery:
     """Write every readable message of `source` (an MCAP file, complete or cut short) into a
-    new, indexed MCAP `path` (written beside it, then renamed). Raises `RoadgazeError` when
-    `source` is not an MCAP file or holds no readable record."""
+    new, indexed MCAP file: `path` when no file has that name, else the first free
+    `free_names(path)` (`Recovery.path` says which); written beside it, then placed without ever
+    replacing a file. Raises `RoadgazeError` when `source` is not an MCAP file or holds no
+    readable record, with `exact` when `path` exists, and when a chunk declares more than
+    `max_chunk_mib` (`record.max_chunk_mib`: never decompressed)."""
+    if exact and (path.exists() or path.is_symlink()):
+        raise RoadgazeError(
+            f"{path} exists; recover never overwrites a file: remove it or choose another --out"
+        )
     size = source.stat().st_size
     temporary = path.with_name(f".{path.name}.recovering")
     schemas: dict[int, int] = {}
@@ -96,20 +98,20 @@ def recover_mcap(source: Path, path: Path) -> Recovery:
     stopped = "end of file"
     try:
         with source.open("rb") as raw, temporary.open("wb") as out:
-            stream = _Counting(raw)
             writer = Writer(out, compression=CompressionType.ZSTD)
             started = False
-            iterator = _records(stream)
+            iterator = top_level_records(
+                raw, max_chunk_bytes(max_chunk_mib), str(source), validate_crc=True
+            )
             while True:
                 try:
                     item = next(iterator, None)
                     if item is None:  # the footer and the closing magic read
-                        good_end = stream.position
+                        good_end += len(MCAP_MAGIC)
                         break
-                    record, end = item
-                    inner = (
-                        list(breakup_chunk(record, True)) if isinstance(record, Chunk) else [record]
-                    )
+                    record, inner, end = item
+                except ChunkTooLargeError:
+                    raise
                 except Exception as exc:  # the first unreadable record ends the recovery
                     stopped = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
                     break
@@ -156,7 +158,7 @@ def recover_mcap(source: Path, path: Path) -> Recovery:
             writer.finish()  # type: ignore[no-untyped-call]
             out.flush()
             os.fsync(out.fileno())
-        temporary.replace(path)
+        path = _place(temporary, path, exact)
     except OSError as exc:
         with contextlib.suppress(OSError):
             temporary.unlink()
@@ -178,6 +180,34 @@ def recover_mcap(source: Path, path: Path) -> Recovery:
     )
 
 
+def free_names(path: Path) -> Iterator[Path]:
+    """`path`, then `NAME-1.SUFFIX`, `NAME-2.SUFFIX`, ... up to `NAME-999.SUFFIX`."""
+    yield path
+    for number in range(1, 1000):
+        yield path.with_name(f"{path.stem}-{number}{path.suffix}")
+
+
+def _place(temporary: Path, path: Path, exact: bool) -> Path:
+    """Give `temporary` the first free name of `free_names(path)` (only `path` when `exact`)
+    without replacing any file; returns the name taken."""
+    for candidate in [path] if exact else free_names(path):
+        try:
+            os.link(temporary, candidate)  # fails, never replaces, when the name is taken
+        except FileExistsError:
+            continue
+        except OSError:  # a file system without hard links: checked, then renamed
+            if candidate.exists() or candidate.is_symlink():
+                continue
+            temporary.replace(candidate)
+            return candidate
+        temporary.unlink()
+        return candidate
+    raise RoadgazeError(
+        f"{path} exists (and {'no other name was asked for' if exact else 'so do 999 others'}); "
+        "recover never overwrites a file: remove it or choose another --out"
+    )
+
+
 def recovered_name(part: Path) -> Path:
     """`NAME.mcap.part` -> `NAME.mcap`; any other name gets `.recovered.mcap`."""
     if part.name.endswith(f".mcap{OPEN_SUFFIX}"):
@@ -190,9 +220,8 @@ def recover_parts(folder: Path, pattern: str) -> list[Recovery]:
     that cannot be recovered is renamed `.unreadable` and left (logged)."""
     done: list[Recovery] = []
     for part in sorted(folder.glob(pattern)):
-        target = recovered_name(part)
         try:
-            recovery = recover_mcap(part, target)
+            recovery = recover_mcap(part, recovered_name(part))
         except RoadgazeError as exc:
             part.replace(part.with_name(f"{part.name}.unreadable"))
             log.warning("record: cannot recover %s, left as .unreadable: %s", part.name, exc)
@@ -202,7 +231,7 @@ def recover_parts(folder: Path, pattern: str) -> list[Recovery]:
         log.warning(
             "record: recovered %s left open by an interrupted run into %s: %s",
             part.name,
-            target.name,
+            recovery.path.name,
             recovery.describe(),
         )
     return done

@@ -24,6 +24,7 @@ from foxglove.mcap import MCAPCompression, MCAPWriteOptions, MCAPWriter
 from roadgaze.config import RecordConfig
 from roadgaze.errors import RoadgazeError
 from roadgaze.outputs.foxglove.channels import TOPIC_IMAGE
+from roadgaze.outputs.foxglove.segment_lock import PrefixLock, claim_prefix, segments_of
 
 log = logging.getLogger(__name__)
 
@@ -235,7 +236,9 @@ class McapSegments:
     segments of this prefix are removed (each logged) until the closed ones and a full new one
     fit in `max_disk_mb`. A segment is rotated when its age reaches `segment_s` or when the next
     flush interval at the recent rate would take it over `segment_mb`. Parts left by a killed
-    run are recovered when the folder is opened (`roadgaze.outputs.foxglove.recover`).
+    run are recovered when the folder is opened (`roadgaze.outputs.foxglove.recover`). The
+    prefix is locked for the run (`segment_lock`): a second run with the same prefix records as
+    `PREFIX.2` and never touches this one's segments; `prefix` is the one in use once open.
     """
 
     def __init__(
@@ -262,6 +265,7 @@ class McapSegments:
         """The segments closed by this run, in order."""
         self.removed: list[Path] = []
         """The segments removed to keep the folder under `max_disk_mb`."""
+        self._lock: PrefixLock | None = None
 
     def open(self, context: foxglove.Context) -> None:
         from roadgaze.outputs.foxglove.recover import recover_parts
@@ -272,16 +276,22 @@ class McapSegments:
             raise RoadgazeError(
                 f"cannot record into {self.folder}: {exc.strerror or exc}"
             ) from None
-        recover_parts(self.folder, f"{self.prefix}-*.mcap{OPEN_SUFFIX}")
-        self._context = context
-        self._open_next(time.monotonic())
+        self._lock, self.prefix = claim_prefix(self.folder, self.prefix)
+        try:
+            for part in segments_of(self.folder, self.prefix, OPEN_SUFFIX):
+                recover_parts(self.folder, part.name)  # a literal name: only this one
+            self._context = context
+            self._open_next(time.monotonic())
+        except BaseException:
+            self._release()
+            raise
 
     def images_wanted(self) -> bool:
         return self.images
 
     def segments_on_disk(self) -> list[Path]:
         """This prefix's closed segments in the folder, oldest first."""
-        found = [path for path in self.folder.glob(f"{self.prefix}-*.mcap") if path.is_file()]
+        found = segments_of(self.folder, self.prefix)
         return sorted(found, key=lambda path: (path.stat().st_mtime_ns, path.name))
 
     def _make_room(self) -> None:
@@ -354,4 +364,12 @@ class McapSegments:
         log.info("record: segment %s closed (%.1f MB)", closed.name, closed.stat().st_size / MB)
 
     def close(self) -> None:
-        self._close_current()
+        try:
+            self._close_current()
+        finally:
+            self._release()
+
+    def _release(self) -> None:
+        lock, self._lock = self._lock, None
+        if lock is not None:
+            lock.release()

@@ -3,8 +3,8 @@
     python scripts/train-phone.py DATA/statefarm-dev [--out PATH] [--features NPZ] [--models lite]
 
 Only the development drivers of the folder are used. Each image goes through the hand stage
-and the face landmarker as stills (`roadgaze.evaluation.phone.image_features`, the vector the
-service judges). The trainer's settings are chosen leaving drivers out (every driver's images
+(with the upper body) and the face landmarker as stills
+(`roadgaze.evaluation.phone.image_features`, the vector the service judges). The trainer's settings are chosen leaving drivers out (every driver's images
 scored by a model fitted without that driver): the candidate with the highest recall at a
 false-positive rate of 0.10 over all other classes, ties to the smaller model. The threshold is
 read from those out-of-fold scores; the final model is fitted on every development driver.
@@ -37,7 +37,7 @@ from roadgaze.evaluation.phone import (  # noqa: E402
 from roadgaze.phone.boosting import BoostSettings, fit  # noqa: E402
 from roadgaze.phone.features import FEATURES  # noqa: E402
 
-VERSION = "1"
+VERSION = "2"
 CANDIDATES = (
     BoostSettings(trees=40, depth=2, learning_rate=0.15),
     BoostSettings(trees=80, depth=3, learning_rate=0.1),

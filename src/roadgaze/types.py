@@ -192,6 +192,8 @@ class AlertKind(StrEnum):
     TEMPORARY_FAILURE = "temporary_failure"
     """The camera cannot judge the driver for now (blocked, black, saturated or frozen frames, no
     judgeable face while moving); `reason` says which. Cleared once recovered."""
+    PHONE_USE = "phone_use"
+    """A phone in the driver's hand while moving (docs/phone.md); cleared once put down."""
     PERMANENT_FAILURE = "permanent_failure"
     """The service cannot monitor at all (camera gone past the reconnect limit, model unusable)."""
     CLEARED = "cleared"

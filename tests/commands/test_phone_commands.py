@@ -70,8 +70,9 @@ def test_model_verify_hands_names_each_file(tmp_path: Path) -> None:
     done = _roadgaze("model", "verify", "hands", ROADGAZE_CACHE_DIR=str(tmp_path))
     assert done.returncode == 1
     lines = done.stdout.splitlines()
-    assert len(lines) == 4 and all("not found" in line for line in lines)
+    assert len(lines) == 6 and all("not found" in line for line in lines)
     assert "hand_landmark_full.tflite" in done.stdout
+    assert "pose_landmark_full.tflite" in done.stdout
 
 
 def test_eval_task_phone_bad_dataset_is_one_line(tmp_path: Path) -> None:

@@ -7,12 +7,12 @@ import csv
 import json
 import math
 import subprocess
-import venv
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from mediapipe_reference import reference_python
 from repo_paths import REPO, STATEFARM
 from roadgaze.config import load_config
 from roadgaze.errors import ModelError
@@ -90,36 +90,6 @@ def test_a_corrupt_model_is_one_line_naming_it(tmp_path: Path) -> None:
 
 # --- MediaPipe 0.10.14 on real drivers ---------------------------------------------------------
 
-REFERENCE_PACKAGES = (
-    "numpy<2",
-    "protobuf<5",
-    "absl-py",
-    "attrs",
-    "flatbuffers",
-)
-
-
-def _reference_python(cache: Path) -> Path:
-    """An interpreter with mediapipe 0.10.14 (made once, kept in the cache); skips when pip
-    cannot install it here."""
-    folder = cache / "mediapipe-0.10.14-reference"
-    python = folder / "bin" / "python"
-    if (folder / "ready").is_file():
-        return python
-    venv.create(folder, with_pip=True, clear=True)
-    for arguments in (["--no-deps", "mediapipe==0.10.14"], list(REFERENCE_PACKAGES)):
-        done = subprocess.run(
-            [str(python), "-m", "pip", "install", "-q", "--disable-pip-version-check", *arguments],
-            capture_output=True,
-            text=True,
-            timeout=900,
-            check=False,
-        )
-        if done.returncode != 0:
-            pytest.skip(f"cannot install the reference mediapipe 0.10.14: {done.stderr[-300:]}")
-    (folder / "ready").write_text("ok\n")
-    return python
-
 
 @pytest.fixture(scope="module")
 def reference_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, dict, Path]:
@@ -145,7 +115,7 @@ def reference_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, dict,
     }
     folder = tmp_path_factory.mktemp("hands-reference")
     np.savez(folder / "images.npz", **images)
-    python = _reference_python(default_cache_dir(config))
+    python = reference_python(default_cache_dir(config))
     subprocess.run(
         [
             str(python),

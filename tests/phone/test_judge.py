@@ -81,4 +81,6 @@ def test_slots_and_the_vector_layout() -> None:
     width = len(HAND_FEATURES)
     assert vector[width - 1] == 1.0 and not vector[width : 2 * width].any()  # right slot empty
     assert vector[0] == pytest.approx(left.landmarks_px[:, 0].mean() / 640, rel=1e-6)
-    assert vector[-4:].tolist() == [0.0, 1.0, 0.0, 0.0]  # no face: no head angles
+    frame = vector[2 * width : 2 * width + 4].tolist()
+    assert frame == [0.0, 1.0, 0.0, 0.0]  # no face: no head angles
+    assert not vector[2 * width + 4 :].any()  # no body

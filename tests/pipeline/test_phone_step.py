@@ -63,3 +63,23 @@ def test_every_frame_carries_the_hands_and_the_judgement_at_the_stage_pace(frame
 def test_phone_detection_off_leaves_the_fields_null(frames: Path) -> None:
     records = _records(frames, enabled=False)
     assert all(r["n_hands"] is None and r["phone_use"] is None for r in records)
+
+
+def test_the_body_is_measured_at_its_own_slower_pace_and_carried_between(frames: Path) -> None:
+    import cv2
+
+    from roadgaze.landmarks.hands.stage import HandStage
+
+    config = load_config(environ={})
+    hands = config.hands.model_copy(update={"interval_s": 0.3, "body_interval_s": 0.9})
+    stage = HandStage.from_config(config.model_copy(update={"hands": hands}))
+    assert stage is not None
+    images = [cv2.imread(str(path)) for path in sorted(frames.iterdir())]
+    body_runs = []
+    try:
+        for index in range(7):  # 0 .. 1.86 s
+            assert stage.run(images[index], index * 0.31).fresh  # the hands every 0.31 s
+            body_runs.append(stage.body_runs)
+    finally:
+        stage.close()
+    assert body_runs == [1, 1, 1, 2, 2, 2, 3]  # the body at 0, 0.93 and 1.86 s, carried between

@@ -62,7 +62,8 @@ def phone_cost(args: argparse.Namespace, config: Config, pipeline_pass: Callable
     hands = config.hands
     print(
         f"phone detection on {args.source}: {hands.models} hand models, hands every "
-        f"{hands.interval_s:g} s, palm detector every {hands.detect_interval_s:g} s at most"
+        f"{hands.interval_s:g} s, palm detector every {hands.detect_interval_s:g} s at most, "
+        f"upper body {'with them' if hands.body else 'off'}"
     )
     print(f"  CPU per frame, off: {_ms(off_ms)} (rounds: {', '.join(_ms(v) for v in off)})")
     print(f"  CPU per frame, on:  {_ms(on_ms)} (rounds: {', '.join(_ms(v) for v in on)})")

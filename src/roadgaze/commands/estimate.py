@@ -84,7 +84,8 @@ class PhoneOfImage:
         points = estimate.landmarks_px
         box = None if points is None else finite_box_px(points[:, :2])
         head = (estimate.mediapipe_yaw_deg, estimate.mediapipe_pitch_deg)
-        verdict = judge_box(found.hands, box, found.size, self._model, self._threshold, head)
+        body = found.body_arrays
+        verdict = judge_box(found.hands, box, found.size, self._model, self._threshold, head, body)
         fields = hand_fields(found.hands, verdict)
         return {
             key: fields[key]

@@ -65,9 +65,11 @@ def _which(parser: argparse.ArgumentParser) -> None:
         nargs="?",
         choices=("face", "hands"),
         default="face",
-        help="face: face_landmarker.task (default); hands: the palm detection and hand landmark "
-        "models, lite and full (palm_detection_*.tflite, hand_landmark_*.tflite: Google's model "
-        "storage, else the PyPI wheel mediapipe==0.10.14; phone detection, docs/phone.md)",
+        help="face: face_landmarker.task (default); hands: the models of phone detection, the "
+        "palm detection and hand landmark models, lite and full (palm_detection_*.tflite, "
+        "hand_landmark_*.tflite), and the pose models (pose_detection.tflite, "
+        "pose_landmark_full.tflite): Google's model storage, else the PyPI wheel "
+        "mediapipe==0.10.14 (docs/phone.md)",
     )
 
 
@@ -140,13 +142,14 @@ def run_verify(args: argparse.Namespace, config: Config) -> int:
 
 
 def _verify_hands(config: Config) -> int:
-    """One line per hand model file in the cache; 0 when all four are valid."""
-    from roadgaze.landmarks.hands.models import HAND_MODEL_FILES
+    """One line per model file of phone detection in the cache (the hands' and the body's); 0
+    when all are valid."""
+    from roadgaze.landmarks.hands.models import MODEL_FILES
     from roadgaze.landmarks.model_store import check_file, default_cache_dir
 
     cache = default_cache_dir(config.model)
     good = True
-    for name, model in HAND_MODEL_FILES.items():
+    for name, model in MODEL_FILES.items():
         problem = check_file(cache / name, model.expected)
         good = good and problem is None
         expected = f"{model.expected.size_bytes} bytes, SHA-256 {model.expected.sha256}"

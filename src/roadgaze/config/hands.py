@@ -35,6 +35,14 @@ class HandsConfig(Section):
     detect_interval_s: float = Field(default=0.6, ge=0)
     """The palm detector runs at most this often while fewer hands are tracked than
     `num_hands` (0: whenever MediaPipe's graph would, i.e. on every such frame)."""
+    body: bool = True
+    """Also find the driver's upper body (MediaPipe's pose detector and landmark model) at the
+    hand stage's pace: the arms judge the frames whose hands are not found (docs/phone.md).
+    False: the classifier sees no body, and finds less phone use."""
+    body_interval_s: float = Field(default=0.9, ge=0)
+    """The body at most this often (0: with every run of the hands); runs of the hands in
+    between carry the last body. An arm holding a phone moves slowly; the body costs about three
+    times the hands (docs/phone.md, Cost)."""
     phone_threshold: float | None = Field(default=None, ge=0, le=1)
     """The phone score from which a frame is judged phone use; None: the shipped classifier's
     own operating point (chosen leaving drivers out, docs/phone.md)."""

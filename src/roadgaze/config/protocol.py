@@ -67,6 +67,13 @@ class ProtocolSettings(Section):
     """ADDW area 1, the roof: above this pitch (relative to the neutral) is always distraction
     (at most ROOF_PITCH_MAX_DEG: higher, no look at a roof would reach it)."""
 
+    # --- phone use (docs/phone.md, docs/monitor.md "Protocols") ---
+    phone_use_s: float = Field(default=3.0, gt=0)
+    """A phone judged in hand this long while moving: `phone_use`."""
+    phone_gap_s: float = Field(default=0.7, gt=0)
+    """A judgement "no phone" (or none) shorter than this does not end a phone-in-hand run;
+    this long, it ends it and clears `phone_use`."""
+
     frame_failure_s: float = Field(default=2.0, gt=0)
     """Blocked, black or saturated frames this long while moving: `temporary_failure`."""
     frozen_failure_s: float = Field(default=10.0, gt=0)

@@ -7,8 +7,9 @@ from roadgaze.doctor.report import Check, Status
 
 
 def check_hands(config: Config) -> list[Check]:
-    """The configured hand models: verified in the cache and loaded by LiteRT (OK), missing or
-    damaged (WARN: the service runs, phone detection is off), or `[hands]` switched off."""
+    """The configured hand models (and, with `[hands] body`, the pose models): verified in the
+    cache and loaded by LiteRT (OK), missing or damaged (WARN: the service runs,
+    phone detection is off), or `[hands]` switched off."""
     from roadgaze.errors import ModelError
     from roadgaze.landmarks.hands.models import find_hand_models, fix_hint, model_names
     from roadgaze.landmarks.model_store import default_cache_dir
@@ -16,7 +17,11 @@ def check_hands(config: Config) -> list[Check]:
     hands = config.hands
     if not hands.enabled:
         return [Check("hands", Status.OK, "phone detection is off ([hands] enabled = false)")]
-    names = model_names(hands.models, hands.models)
+    names: tuple[str, ...] = model_names(hands.models, hands.models)
+    if hands.body:  # the upper body's models, provisioned with the hands'
+        from roadgaze.landmarks.pose.models import DETECTOR_NAME, LANDMARKS_NAME
+
+        names = (*names, DETECTOR_NAME, LANDMARKS_NAME)
     found, problems = find_hand_models(config.model, names)
     if problems:
         return [
@@ -31,6 +36,10 @@ def check_hands(config: Config) -> list[Check]:
         from roadgaze.landmarks.hands.engine import HandLandmarker, HandSettings
 
         HandLandmarker(found[names[0]], found[names[1]], HandSettings()).close()
+        if len(names) == 4:  # and the body's
+            from roadgaze.landmarks.pose.engine import PoseLandmarker, PoseSettings
+
+            PoseLandmarker(found[names[2]], found[names[3]], PoseSettings()).close()
     except (ImportError, ModelError) as exc:
         return [Check("hands", Status.WARN, f"phone detection is off: {exc}", "pip install "
                       "'ai-edge-litert==2.3.0' or roadgaze model fetch hands --force")]  # fmt: skip

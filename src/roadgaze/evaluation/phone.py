@@ -139,8 +139,9 @@ def image_features(
             head = (
                 (None, None) if face is None else (face.mediapipe_yaw_deg, face.mediapipe_pitch_deg)
             )
-            x[row] = frame_vector(hands.hands, box, hands.size, head)
-            judged[row] = bool(hands.hands) or box is not None
+            body = hands.body_arrays
+            x[row] = frame_vector(hands.hands, box, hands.size, head, body)
+            judged[row] = bool(hands.hands) or box is not None or body is not None
     finally:
         stage.close()
         faces.close()

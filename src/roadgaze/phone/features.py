@@ -10,7 +10,7 @@ in face widths. The frame's vector (`FEATURES`) has a slot for the driver's own 
 one for the right (the more confident hand of a side; a second hand of the same side takes the
 empty slot), each with a presence flag, then whether a face was found, how many hands, and the
 head's yaw and pitch as MediaPipe's face matrix gives them (0 without: a driver reading a phone
-looks down at it).
+looks down at it), then the upper body's arms (`roadgaze.phone.body.BODY_FEATURES`).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
+from roadgaze.phone.body import BODY_FEATURES, body_vector
 from roadgaze.types import Hand, HandSide
 
 FINGER_TIPS = (4, 8, 12, 16, 20)
@@ -47,10 +48,13 @@ FEATURES = (
     "hands",
     "head_yaw_deg",
     "head_pitch_deg",
+    *BODY_FEATURES,
 )
 """The classifier's input vector, in order."""
 
 FaceBox = tuple[float, float, float, float]
+Body = tuple[npt.NDArray[np.floating], npt.NDArray[np.floating]]
+"""The upper body: (33, 2+) pose landmarks in image fractions and their (33,) visibilities."""
 
 
 def hand_size_px(points: npt.NDArray[np.floating]) -> float:
@@ -120,15 +124,18 @@ def frame_vector(
     face: FaceBox | None,
     size: tuple[int, int],
     head_deg: tuple[float | None, float | None] = (None, None),
+    body: Body | None = None,
 ) -> npt.NDArray[np.float64]:
     """`FEATURES` of one frame (an empty slot is all zeros); `head_deg` is the face's (yaw,
-    pitch) from MediaPipe's matrix (yaw > 0: turned to the driver's left; pitch > 0: up)."""
+    pitch) from MediaPipe's matrix (yaw > 0: turned to the driver's left; pitch > 0: up);
+    `body` the upper body (`roadgaze.phone.body`; None: none found)."""
     empty = [0.0] * len(HAND_FEATURES)
     values: list[float] = []
     for hand in slots(hands):
         values += empty if hand is None else hand_vector(hand, face, size)
     yaw, pitch = head_deg
     values += [float(face is not None), float(len(hands)), _finite(yaw), _finite(pitch)]
+    values += body_vector(*body) if body is not None else body_vector(None, None)
     return np.asarray(values, np.float64)
 
 

@@ -5,7 +5,8 @@
 scores higher) and where it is held: at the `ear` (within `EAR_FACE_WIDTHS` face widths of the
 face's centre), in the `lap` (its centre in the image's lowest `LAP_IMAGE_FRACTION`, a camera in
 front of the driver seeing the lap at the bottom) or `held_up` (in front, above the lap). Without
-hands and without a face it cannot judge (`phone_use` None).
+hands, a face and a body it cannot judge (`phone_use` None); judged from the body alone, the
+hand and the place are not named.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from roadgaze.phone.features import FaceBox, frame_vector
+from roadgaze.phone.features import Body, FaceBox, frame_vector
 from roadgaze.phone.model import PhoneModel
 from roadgaze.types import FaceFeatures, Hand, PhoneJudgement, PhonePose
 
@@ -52,10 +53,12 @@ def judge(
     size: tuple[int, int],
     model: PhoneModel,
     threshold: float | None = None,
+    body: Body | None = None,
 ) -> PhoneJudgement:
-    """The frame's phone judgement; `threshold` None is the model's own operating point."""
+    """The frame's phone judgement; `threshold` None is the model's own operating point;
+    `body` the upper body (None: none found)."""
     head = (None, None) if face is None else (face.mediapipe_yaw_deg, face.mediapipe_pitch_deg)
-    return judge_box(hands, face_box(face), size, model, threshold, head)
+    return judge_box(hands, face_box(face), size, model, threshold, head, body)
 
 
 def judge_box(
@@ -65,16 +68,19 @@ def judge_box(
     model: PhoneModel,
     threshold: float | None = None,
     head_deg: tuple[float | None, float | None] = (None, None),
+    body: Body | None = None,
 ) -> PhoneJudgement:
     """`judge` with the face as its box in pixels (None: no face) and the head's MediaPipe
     (yaw, pitch) in degrees."""
-    if not hands and box is None:
+    if not hands and box is None and body is None:
         return PhoneJudgement(phone_use=None, score=None)
     cut = model.threshold if threshold is None else threshold
-    score = model.score(frame_vector(hands, box, size, head_deg))
+    score = model.score(frame_vector(hands, box, size, head_deg, body))
     if score < cut or not hands:
         return PhoneJudgement(phone_use=score >= cut, score=score)
-    holder = max(hands, key=lambda hand: model.score(frame_vector([hand], box, size, head_deg)))
+    holder = max(
+        hands, key=lambda hand: model.score(frame_vector([hand], box, size, head_deg, body))
+    )
     return PhoneJudgement(
         phone_use=True, score=score, hand=holder.side, pose=phone_pose(holder, box, size)
     )

@@ -37,8 +37,9 @@ class PhoneStage:
         """`sample` with this frame's hands and phone judgement."""
         found = self.hands.run(frame.image, frame.t_s)
         if found.fresh or self._last is None:
+            body = found.body_arrays
             self._last = judge(
-                found.hands, sample.features, found.size, self._model, self._threshold
+                found.hands, sample.features, found.size, self._model, self._threshold, body
             )
         return replace(sample, hands=found.hands, phone=self._last)
 

@@ -141,6 +141,7 @@ class Health:
         if self.permanent_failure:
             problems.append(f"permanent failure: {self.permanent_failure}")
         ambiguous = "" if record is None else record.sample.driver_ambiguous
+        phone = None if record is None else record.sample.phone
         if ambiguous:
             problems.append(f"driver ambiguous: {ambiguous}")
         problems.extend(problem for check in self.problem_checks if (problem := check()))
@@ -188,6 +189,8 @@ class Health:
                 distraction_warn_s=verdict.distraction_warn_s,
                 distraction_rule=verdict.distraction_rule,
                 failure=verdict.failure,
+                phone_detection=phone is not None,
+                phone_use=None if phone is None else phone.phone_use,
             ),
             config={
                 "monitor": monitor.model_dump(mode="json"),

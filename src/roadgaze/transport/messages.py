@@ -24,8 +24,8 @@ from roadgaze.types import (
 )
 
 YAW_SCHEMA = "roadgaze.yaw/3"
-ALERT_SCHEMA = "roadgaze.alert/3"
-STATE_SCHEMA = "roadgaze.state/5"
+ALERT_SCHEMA = "roadgaze.alert/4"
+STATE_SCHEMA = "roadgaze.state/6"
 
 
 class _Message(BaseModel):
@@ -174,10 +174,11 @@ class AlertMessage(_Message):
     `degraded`, and the fields `closure_s`, `perclos` and `reason`; `roadgaze.alert/3` adds the
     kinds `temporary_failure` and `permanent_failure` (with the failure in `reason`) and the
     fields `rule` and `source`: the protocol rule the alert fired by and where that rule comes
-    from (docs/monitor.md, "Protocols"). Every earlier field keeps its name and meaning.
+    from (docs/monitor.md, "Protocols"); `roadgaze.alert/4` adds the kind `phone_use` (a phone in
+    hand while moving, docs/phone.md). Every earlier field keeps its name and meaning.
     """
 
-    schema_id: Literal["roadgaze.alert/3"] = Field(default="roadgaze.alert/3", alias="schema")
+    schema_id: Literal["roadgaze.alert/4"] = Field(default="roadgaze.alert/4", alias="schema")
     vehicle_id: str
     seq: int = Field(ge=0)
     kind: AlertKind
@@ -322,6 +323,16 @@ class MonitorSnapshot(EyeFields):
         description="none, learning or calibrated: the eyes move the gaze only once the "
         "driver's resting eye direction is learned (calibrated).",
     )
+    phone_detection: bool = Field(
+        default=False,
+        description="roadgaze.state/6: phone detection runs (false: `[hands] enabled` is off or "
+        "the hand models are missing, so `phone_use` is never raised).",
+    )
+    phone_use: bool | None = Field(
+        default=None,
+        description="roadgaze.state/6: the last frame's phone judgement (null: it cannot judge, "
+        "or phone detection is off).",
+    )
 
 
 class StateMessage(_Message):
@@ -336,11 +347,12 @@ class StateMessage(_Message):
     failure in force, and the eye calibration (`eye_calibration`); `permanent_failure` (the
     camera gone past `permanent_failure_s`); and `alerts_waiting`, `alerts_lost` and
     `undelivered_alerts` to `transport` (the alert ledger). `roadgaze.state/5` adds
-    `driver_ambiguous`. The monitor's angles are in the driver's frame (the camera mounting
+    `driver_ambiguous`; `roadgaze.state/6` adds `phone_detection` and `phone_use` to `monitor`.
+    The monitor's angles are in the driver's frame (the camera mounting
     applied). Every earlier field keeps its name and meaning.
     """
 
-    schema_id: Literal["roadgaze.state/5"] = Field(default="roadgaze.state/5", alias="schema")
+    schema_id: Literal["roadgaze.state/6"] = Field(default="roadgaze.state/6", alias="schema")
     vehicle_id: str
     wall_time: float
     status: Literal["starting", "running", "degraded", "stopping", "stopped"]

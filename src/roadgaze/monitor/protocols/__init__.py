@@ -21,6 +21,7 @@ from roadgaze.monitor.behaviours import (
     Distraction,
     Drowsy,
     EyeClosure,
+    PhoneUse,
     TemporaryFailure,
     Unavailable,
     Unresponsive,
@@ -56,6 +57,8 @@ TABLE: tuple[tuple[str, Behaviour[Any]], ...] = (
     ("roadgaze", Drowsy(roadgaze.DROWSY, euroncap.DROWSINESS, euroncap.DROWSINESS_SPEED)),
     ("roadgaze", Degraded(euroncap.IMPAIRED)),
     ("euroncap", Unresponsive(euroncap.UNRESPONSIVE_AWAY, euroncap.UNRESPONSIVE_AFTER_WARNING)),
+    # --- phone use (docs/phone.md) ---
+    ("euroncap", PhoneUse(euroncap.PHONE_USE, euroncap.PHONE_GAP)),
     (
         "roadgaze",
         TemporaryFailure(

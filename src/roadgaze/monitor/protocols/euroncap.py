@@ -19,6 +19,8 @@ __all__ = [
     "IMPAIRED",
     "LONG_DISTRACTION",
     "MICROSLEEP",
+    "PHONE_GAP",
+    "PHONE_USE",
     "RULES",
     "SLEEP",
     "UNRESPONSIVE_AFTER_WARNING",
@@ -120,7 +122,36 @@ DROWSINESS_SPEED = Rule(
 )
 _DISTRACTION = (ACTIVE, LONG_DISTRACTION, VATS, VATS_WINDOW, VATS_REARM)
 _UNRESPONSIVE = (UNRESPONSIVE_AFTER_WARNING, UNRESPONSIVE_AWAY, UNRESPONSIVE_CLOSED)
-RULES = (*_DISTRACTION, *_UNRESPONSIVE, MICROSLEEP, SLEEP, IMPAIRED, DROWSINESS, DROWSINESS_SPEED)
+# --- phone use ---
+PHONE_USE = Rule(
+    "euroncap.phone_use",
+    "phone_use_s",
+    "s",
+    "Euro NCAP 2026 Safe Driving, Driver Engagement: phone use (basic: a phone in a known "
+    "place, advanced: held up at the wheel or in view) is a transient distraction of the "
+    "dossier's rows 51-64; the 2026 text's own time was not readable here, so roadgaze warns "
+    "after the long distraction's 3 s (roadgaze's choice)",
+    "a phone judged in hand this long while moving",
+)
+PHONE_GAP = Rule(
+    "euroncap.phone_use.gap",
+    "phone_gap_s",
+    "s",
+    "roadgaze's choice (the hand stage misses a held phone on some frames)",
+    "a phone out of sight this long ends the phone use",
+)
+_PHONE = (PHONE_USE, PHONE_GAP)
+
+RULES = (
+    *_DISTRACTION,
+    *_UNRESPONSIVE,
+    MICROSLEEP,
+    SLEEP,
+    IMPAIRED,
+    DROWSINESS,
+    DROWSINESS_SPEED,
+    *_PHONE,
+)
 
 
 def active(config: MonitorConfig, speed_kmh: float | None) -> bool:

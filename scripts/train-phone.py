@@ -4,10 +4,11 @@
 
 Only the development drivers of the folder are used. Each image goes through the hand stage
 (with the upper body) and the face landmarker as stills
-(`roadgaze.evaluation.phone.image_features`, the vector the service judges). The trainer's settings are chosen leaving drivers out (every driver's images
-scored by a model fitted without that driver): the candidate with the highest recall at a
-false-positive rate of 0.10 over all other classes, ties to the smaller model. The threshold is
-read from those out-of-fold scores; the final model is fitted on every development driver.
+(`roadgaze.evaluation.phone.image_features`, the vector the service judges). The trainer's
+settings are chosen leaving drivers out (every driver's images scored by a model fitted without
+that driver): the candidate with the highest recall at a false-positive rate of 0.10 over all
+other classes, ties to the smaller model. The threshold is read from those out-of-fold scores;
+the final model is fitted on every development driver.
 `--features` caches the feature matrix (re-running on the same images skips the models).
 """
 

@@ -47,7 +47,7 @@ def test_run_demo_delivers_every_alert_to_the_subscriber(tmp_path: Path) -> None
     np.testing.assert_allclose([f["t_s"] for f in frames], truth[:, 0], atol=1e-3)
     alerts = [json.loads(line) for line in (folder / "alerts.jsonl").read_text().splitlines()]
     assert alerts == list(result.alerts_received)
-    assert alerts[0]["schema"] == "roadgaze.alert/3" and abs(alerts[0]["yaw_deg"]) < 10.0
+    assert alerts[0]["schema"] == "roadgaze.alert/4" and abs(alerts[0]["yaw_deg"]) < 10.0
     assert frames[-1]["gaze"] == "on_road" and frames[-1]["zone"] == "road"
     looking_down = [f for f in frames if 2.0 <= f["t_s"] <= 4.5]
     assert {f["zone"] for f in looking_down} == {"lap"}

@@ -24,12 +24,12 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     assert {"yaw_deg", "off_road_s"} <= set(schemas["alert"]["properties"])
     yaw_fields = {"schema", "vehicle_id", "seq", "t_s", "frame", "face", "yaw_deg", "yaw_raw_deg"}
     assert yaw_fields | {"on_road"} <= set(schemas["yaw"]["properties"])
-    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/3"
+    assert schemas["alert"]["properties"]["schema"]["const"] == "roadgaze.alert/4"
     # roadgaze.yaw/2 extends /1 with the pose and the zone; every field is always published
     new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
     assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
     assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/3"
-    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/5"
+    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/6"
     snapshot = schemas["state"]["$defs"]["MonitorSnapshot"]
     assert {"zone", "neutral_pitch_deg", "pitch_deg"} <= set(snapshot["required"])
     # yaw/3 and state/3 add the eyes; alert/2 the closure and drowsiness kinds

@@ -103,7 +103,7 @@ def test_schemas_validate_the_messages() -> None:
     jsonschema.validate(json.loads(yaw_message(3).to_json_bytes()), SCHEMAS["yaw"])
     alert = json.loads(alert_message().to_json_bytes())
     jsonschema.validate(alert, SCHEMAS["alert"])
-    assert alert["schema"] == "roadgaze.alert/3"
+    assert alert["schema"] == "roadgaze.alert/4"
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(alert | {"kind": "sneeze"}, SCHEMAS["alert"])
 

@@ -19,6 +19,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
 from roadgaze.config.hands import HandsConfig
+from roadgaze.config.notices import NoticeSettings
 from roadgaze.config.protocol import ProtocolSettings
 from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section as _Section
@@ -160,7 +161,7 @@ class SmoothingConfig(_Section):
         return self
 
 
-class MonitorConfig(EyeMonitorSettings, ProtocolSettings):
+class MonitorConfig(EyeMonitorSettings, NoticeSettings, ProtocolSettings):
     """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)

@@ -232,6 +232,7 @@ def preset_scenarios(config: MonitorConfig) -> list[Scenario]:
 
 def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
     """Every scenario, in report order."""
+    from roadgaze.conformance.notices import notice_scenarios
     from roadgaze.conformance.timers import camera_scenarios, eye_scenarios, vats_scenarios
 
     return [
@@ -240,4 +241,6 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
         *eye_scenarios(config),
         *camera_scenarios(config),
         *preset_scenarios(config),
+        # The non-functional notices (Euro NCAP general requirements).
+        *notice_scenarios(config),
     ]

@@ -24,8 +24,8 @@ from roadgaze.types import (
 )
 
 YAW_SCHEMA = "roadgaze.yaw/3"
-ALERT_SCHEMA = "roadgaze.alert/3"
-STATE_SCHEMA = "roadgaze.state/5"
+ALERT_SCHEMA = "roadgaze.alert/4"
+STATE_SCHEMA = "roadgaze.state/6"
 
 
 class _Message(BaseModel):
@@ -173,10 +173,12 @@ class AlertMessage(_Message):
     `degraded`, and the fields `closure_s`, `perclos` and `reason`; `roadgaze.alert/3` adds the
     kinds `temporary_failure` and `permanent_failure` (with the failure in `reason`) and the
     fields `rule` and `source`: the protocol rule the alert fired by and where that rule comes
-    from (docs/monitor.md, "Protocols"). Every earlier field keeps its name and meaning.
+    from (docs/monitor.md, "Protocols"); `roadgaze.alert/4` adds the kind `non_functional`
+    (the eyes or the face hidden while the camera works; the condition in `reason`). Every
+    earlier field keeps its name and meaning.
     """
 
-    schema_id: Literal["roadgaze.alert/3"] = Field(default="roadgaze.alert/3", alias="schema")
+    schema_id: Literal["roadgaze.alert/4"] = Field(default="roadgaze.alert/4", alias="schema")
     vehicle_id: str
     seq: int = Field(ge=0)
     kind: AlertKind
@@ -321,6 +323,12 @@ class MonitorSnapshot(EyeFields):
         description="none, learning or calibrated: the eyes move the gaze only once the "
         "driver's resting eye direction is learned (calibrated).",
     )
+    non_functional: str = Field(
+        default="",
+        description="roadgaze.state/6: the non-functional notice in force ('' for none), with "
+        "its reason, e.g. 'eyes_hidden: eyes hidden facing the road (eyes hidden) 5.0 s'; "
+        "shown in every state message while it lasts (docs/monitor.md).",
+    )
 
 
 class StateMessage(_Message):
@@ -335,11 +343,13 @@ class StateMessage(_Message):
     failure in force, and the eye calibration (`eye_calibration`); `permanent_failure` (the
     camera gone past `permanent_failure_s`); and `alerts_waiting`, `alerts_lost` and
     `undelivered_alerts` to `transport` (the alert ledger). `roadgaze.state/5` adds
-    `driver_ambiguous`. The monitor's angles are in the driver's frame (the camera mounting
-    applied). Every earlier field keeps its name and meaning.
+    `driver_ambiguous`; `roadgaze.state/6` adds `non_functional` to `monitor` (the
+    non-functional notice in force, shown for as long as it lasts). The monitor's angles are in
+    the driver's frame (the camera mounting applied). Every earlier field keeps its name and
+    meaning.
     """
 
-    schema_id: Literal["roadgaze.state/5"] = Field(default="roadgaze.state/5", alias="schema")
+    schema_id: Literal["roadgaze.state/6"] = Field(default="roadgaze.state/6", alias="schema")
     vehicle_id: str
     wall_time: float
     status: Literal["starting", "running", "degraded", "stopping", "stopped"]

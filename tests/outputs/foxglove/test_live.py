@@ -84,8 +84,8 @@ def test_a_client_is_told_every_channel_subscribes_and_receives_records_and_imag
             "/roadgaze/annotations": "foxglove.ImageAnnotations",
             "/roadgaze/record": "roadgaze.record",
             "/roadgaze/limits": "roadgaze.limits",
-            "/roadgaze/alerts": "roadgaze.alert/3",
-            "/roadgaze/state": "roadgaze.state/5",
+            "/roadgaze/alerts": "roadgaze.alert/4",
+            "/roadgaze/state": "roadgaze.state/6",
             "/roadgaze/log": "foxglove.Log",
             "/roadgaze/driver": "roadgaze.driver/1",
         }

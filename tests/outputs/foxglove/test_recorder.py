@@ -76,8 +76,8 @@ def test_each_channel_has_its_well_known_or_own_schema(
         TOPIC_ANNOTATIONS: "foxglove.ImageAnnotations",
         TOPIC_RECORD: "roadgaze.record",
         TOPIC_LIMITS: "roadgaze.limits",
-        TOPIC_ALERTS: "roadgaze.alert/3",
-        TOPIC_STATE: "roadgaze.state/5",
+        TOPIC_ALERTS: "roadgaze.alert/4",
+        TOPIC_STATE: "roadgaze.state/6",
         TOPIC_DRIVER: "roadgaze.driver/1",
     }
     assert contents.encodings[TOPIC_IMAGE] == ("protobuf", "protobuf")

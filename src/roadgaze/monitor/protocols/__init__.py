@@ -21,6 +21,7 @@ from roadgaze.monitor.behaviours import (
     Distraction,
     Drowsy,
     EyeClosure,
+    NonFunctional,
     TemporaryFailure,
     Unavailable,
     Unresponsive,
@@ -56,6 +57,13 @@ TABLE: tuple[tuple[str, Behaviour[Any]], ...] = (
     ("roadgaze", Drowsy(roadgaze.DROWSY)),
     ("roadgaze", Degraded(euroncap.IMPAIRED)),
     ("euroncap", Unresponsive(euroncap.UNRESPONSIVE_AWAY, euroncap.UNRESPONSIVE_AFTER_WARNING)),
+    # Non-functional notices (Euro NCAP general requirements).
+    (
+        "euroncap",
+        NonFunctional(
+            euroncap.NON_FUNCTIONAL, euroncap.NON_FUNCTIONAL_REPEAT, euroncap.NON_FUNCTIONAL_CLEAR
+        ),
+    ),
     (
         "roadgaze",
         TemporaryFailure(

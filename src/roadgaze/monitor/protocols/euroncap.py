@@ -17,6 +17,9 @@ __all__ = [
     "IMPAIRED",
     "LONG_DISTRACTION",
     "MICROSLEEP",
+    "NON_FUNCTIONAL",
+    "NON_FUNCTIONAL_CLEAR",
+    "NON_FUNCTIONAL_REPEAT",
     "RULES",
     "SLEEP",
     "UNRESPONSIVE_AFTER_WARNING",
@@ -97,9 +100,38 @@ IMPAIRED = Rule(
     f"{_DSM}: impaired monitoring told to the driver within 10 s",
     "eyes unavailable this long: monitoring degraded",
 )
+
+# Non-functional notices (roadgaze.monitor.behaviours.non_functional).
+_GENERAL = "Euro NCAP 2026 Safe Driving, Driver Engagement, DSM general requirements"
+NON_FUNCTIONAL = Rule(
+    "euroncap.non_functional",
+    "non_functional_after_s",
+    "s",
+    f"{_GENERAL}: inform of a non-functional system within 10 s (dark sunglasses, a cap, a hat, "
+    "a hair fringe, thick eyelash makeup, the sensor obstructed by a hand on the wheel); the "
+    "5 s default is roadgaze's choice",
+    "the eyes or the face hidden this long while facing the road: not functional",
+)
+NON_FUNCTIONAL_REPEAT = Rule(
+    "euroncap.non_functional.repeat",
+    "non_functional_repeat_s",
+    "s",
+    f"{_GENERAL}: visual information about a non-functional system shown permanently or every "
+    "10 minutes",
+    "a notice in force is raised again this often",
+)
+NON_FUNCTIONAL_CLEAR = Rule(
+    "euroncap.non_functional.clear",
+    "non_functional_clear_s",
+    "s",
+    "roadgaze's choice",
+    "the notice ends once the condition has been gone this long",
+)
+_NOTICES = (NON_FUNCTIONAL, NON_FUNCTIONAL_REPEAT, NON_FUNCTIONAL_CLEAR)
+
 _DISTRACTION = (ACTIVE, LONG_DISTRACTION, VATS, VATS_WINDOW, VATS_REARM)
 _UNRESPONSIVE = (UNRESPONSIVE_AFTER_WARNING, UNRESPONSIVE_AWAY, UNRESPONSIVE_CLOSED)
-RULES = (*_DISTRACTION, *_UNRESPONSIVE, MICROSLEEP, SLEEP, IMPAIRED)
+RULES = (*_DISTRACTION, *_UNRESPONSIVE, MICROSLEEP, SLEEP, IMPAIRED, *_NOTICES)
 
 
 def active(config: MonitorConfig, speed_kmh: float | None) -> bool:

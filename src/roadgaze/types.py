@@ -196,6 +196,11 @@ class AlertKind(StrEnum):
     """A phone in the driver's hand while moving (docs/phone.md); cleared once put down."""
     PERMANENT_FAILURE = "permanent_failure"
     """The service cannot monitor at all (camera gone past the reconnect limit, model unusable)."""
+    NON_FUNCTIONAL = "non_functional"
+    """The driver's monitoring is not functional: the eyes hidden (dark sunglasses, a brim, a
+    fringe) or the face hidden (a hand on the wheel in front of the camera) while the camera
+    itself works; `reason` says which. Raised again every `non_functional_repeat_s` while it
+    lasts; cleared when it ends."""
     CLEARED = "cleared"
 
 

@@ -98,6 +98,18 @@ def test_sunglasses_cover_the_eyes(renderer: ScenarioRenderer) -> None:
     assert grey(dark)[changed].mean() < 30.0
 
 
+def test_worn_from_puts_the_condition_on_at_its_segment(renderer: ScenarioRenderer) -> None:
+    """A scenario with `worn_from` shows the bare face before that segment, dressed from it."""
+    segments = (Segment(0.4, label="ahead"), Segment(0.4, label="worn"))
+    bare = Scenario("w", "", segments, 70.0, ())
+    late = Scenario("w", "", segments, 70.0, (), conditions=("dark_sunglasses",), worn_from="worn")
+    pairs = list(zip(renderer.frames(bare), renderer.frames(late), strict=True))
+    assert len(pairs) == 4  # 5 fps: 0.0 and 0.2 s bare, from 0.4 s on
+    before = [np.abs(grey(a) - grey(b)).mean() for a, b in pairs[:2]]
+    after = [np.abs(grey(a) - grey(b)).mean() for a, b in pairs[2:]]
+    assert max(before) < 0.5 < 2.0 < min(after)
+
+
 def test_side_files_and_the_source(renderer: ScenarioRenderer, tmp_path: Path) -> None:
     scenario = Scenario("drive", "", (Segment(1.2),), 35.0, ())
     track = renderer.write_side_files(scenario, tmp_path)

@@ -22,6 +22,7 @@ from roadgaze.conformance.dossier import (
     outcomes_by_key,
     with_gates_met,
 )
+from roadgaze.conformance.notices import notice_key
 
 SCENARIOS = euroncap_scenarios()
 
@@ -99,8 +100,9 @@ def test_a_noise_variable_stops_at_the_first_scenario_failing_under_it() -> None
 
 
 def test_general_requirements_answer_pass_fail_or_na_with_their_basis() -> None:
-    outcomes = outcomes_of(SCENARIOS, failed=("lap_70.warns",))
-    dossier = judge(outcomes, SCENARIOS, FakeRunner(failing=failing_under("cap")), "lhd")
+    outcomes = outcomes_of(SCENARIOS, failed=("lap_70.warns", notice_key("hat")))
+    runner = FakeRunner(failing=failing_under("cap", "hat"))
+    dossier = judge(outcomes, SCENARIOS, runner, "lhd")
     answers = {g.requirement.text: g for g in dossier.general}
     assert answers["Default ON at the start of every journey"].value == "FAIL"
     assert answers["Continuous monitoring of the driver state"].value == "PASS"
@@ -109,7 +111,10 @@ def test_general_requirements_answer_pass_fail_or_na_with_their_basis() -> None:
     sunglasses = next(g for text, g in answers.items() if text.endswith("dark sunglasses"))
     assert sunglasses.value == "N/A"  # dark sunglasses shown functional: nothing to inform of
     cap = next(g for text, g in answers.items() if text.endswith("wears a cap"))
-    assert cap.value == "FAIL"  # the cap not shown functional: a notice is due
+    assert cap.value == "PASS"  # the cap not shown functional: its notice was measured
+    assert cap.why.startswith("the service raised `non_functional` within 10 s")
+    hat = next(g for text, g in answers.items() if text.endswith("wears a hat"))
+    assert hat.value == "FAIL" and hat.why.startswith("FAIL: notice_hat_70.told")
 
 
 def test_the_gates_name_what_holds_the_score_and_can_be_taken_as_met() -> None:
@@ -120,7 +125,7 @@ def test_the_gates_name_what_holds_the_score_and_can_be_taken_as_met() -> None:
         "mandatory noise variables not shown functional: Daytime - Night-time, Clear "
         "sunglasses, Short facial hair, Long facial hair, Face-mask"
     )
-    assert gates[1].startswith("7 general requirements not met: speed activation of distraction")
+    assert gates[1].startswith("2 general requirements not met: speed activation of distraction")
     assert "impairment" not in gates[1]  # drowsiness' scenarios passed: its activation is shown
     opened = with_gates_met(dossier)
     assert opened.gates() == [] and opened.cells == dossier.cells

@@ -64,7 +64,7 @@ def test_the_table_runs_each_protocols_behaviours_in_order_clearing_last(
     protocol: str, expected: list[str]
 ) -> None:
     names = [type(b).__name__ for b in behaviours(protocol)]
-    ncap = ["Unresponsive", "PhoneUse"] if protocol != "addw" else []
+    ncap = ["Unresponsive", "PhoneUse", "NonFunctional"] if protocol != "addw" else []
     assert names == [*expected, *ncap, "TemporaryFailure", "Clearing"]
     assert isinstance(behaviours(protocol)[-1], Clearing)
 

@@ -196,10 +196,16 @@ def test_unavailable_eyes_fall_back_to_the_head_and_degrade_after_ten_seconds() 
     turned = eyes_of(usable=False)
     _, alerts = run(between(2.0, 14.0, turned), 16.0)
     # Euro NCAP needs the eyes (closures): unjudgeable eyes are also a temporary failure.
-    assert kinds(alerts) == ["degraded:warning", "temporary_failure:warning", "cleared:info"]
-    assert near(alerts[0].t_s, 12.0) and near(alerts[1].t_s, 12.0) and near(alerts[2].t_s, 14.0)
-    assert alerts[1].reason == "eyes unjudgeable"
-    assert alerts[2].clears == (AlertKind.DEGRADED, AlertKind.TEMPORARY_FAILURE)
+    # Facing the road with eyes that cannot be judged: not functional, told after 5 s.
+    assert kinds(alerts) == [
+        "non_functional:warning",
+        "degraded:warning",
+        "temporary_failure:warning",
+        "cleared:info",
+    ]
+    assert near(alerts[0].t_s, 7.0) and near(alerts[1].t_s, 12.0) and near(alerts[2].t_s, 12.0)
+    assert near(alerts[3].t_s, 14.0) and alerts[2].reason == "eyes unjudgeable"
+    assert alerts[3].clears == (AlertKind.DEGRADED, AlertKind.TEMPORARY_FAILURE)
     probe, _ = run(between(2.0, 14.0, turned), 13.0)
     assert probe.verdict.eyes.degraded and probe.verdict.eyes.gaze_source == "head"
     assert probe.verdict.zone == "road" and probe.verdict.eyes.status is EyeStatus.UNAVAILABLE
@@ -215,11 +221,16 @@ def test_a_distraction_alert_clears_but_degraded_stays_while_the_eyes_are_hidden
 
     monitor, alerts = run(script, 20.0)
     assert kinds(alerts) == [
+        "non_functional:warning",
         "degraded:warning",
         "temporary_failure:warning",
         "long_distraction:warning",
         "cleared:info",
     ]
     assert alerts[-1].clears == (AlertKind.LONG_DISTRACTION,)
-    assert monitor.verdict.active == (AlertKind.DEGRADED, AlertKind.TEMPORARY_FAILURE)
+    assert monitor.verdict.active == (
+        AlertKind.NON_FUNCTIONAL,  # the glance away with the lenses on ends nothing
+        AlertKind.DEGRADED,
+        AlertKind.TEMPORARY_FAILURE,
+    )
     assert monitor.verdict.eyes.reason == "eyes hidden"

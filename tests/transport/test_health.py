@@ -150,17 +150,21 @@ def test_state_is_degraded_while_the_eyes_have_been_unavailable_ten_seconds() ->
             state = health.state_message()
             assert state.status == "degraded" and state.monitor.degraded
             assert state.problems == [
-                "eyes unavailable for 11 s (head turned): monitoring on head pose only"
+                "eyes unavailable for 11 s (head turned): monitoring on head pose only",
+                "not functional: eyes_hidden: eyes hidden facing the road (head turned) 5.0 s",
             ]
+            assert state.monitor.non_functional.startswith("eyes_hidden: eyes hidden facing")
             assert (state.monitor.eyes, state.monitor.gaze_source) == ("unavailable", "head")
             assert state.monitor.eye_calibration == "none"  # nothing to learn from yet
             jsonschema.validate(json.loads(state.to_json_bytes()), SCHEMAS["state"])
     state = health.state_message()
     assert (state.status, state.problems, state.monitor.eyes) == ("running", [], "open")
     assert state.monitor.eye_calibration == "calibrated"  # 4 s of open eyes on the road
-    # Euro NCAP needs the eyes: unjudgeable eyes are also a temporary failure (alert/3)
+    # Euro NCAP needs the eyes: unjudgeable eyes are also a temporary failure (alert/3), and
+    # facing the road, a non-functional notice (alert/4), cleared 2 s after the eyes are back
     kinds = [a.kind for a in health.recent_alerts]
-    assert kinds == ["degraded", "temporary_failure", "cleared"]
+    assert kinds == ["non_functional", "degraded", "temporary_failure", "cleared", "cleared"]
+    assert state.monitor.non_functional == ""
 
 
 @pytest.mark.parametrize(

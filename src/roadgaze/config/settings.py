@@ -21,6 +21,7 @@ from roadgaze.config.drowsiness import DrowsinessSettings
 from roadgaze.config.eyes import EyeMonitorSettings, EyesConfig
 from roadgaze.config.hands import HandsConfig
 from roadgaze.config.locations import LocationConfig
+from roadgaze.config.notices import NoticeSettings
 from roadgaze.config.protocol import ProtocolSettings
 from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section as _Section
@@ -162,7 +163,7 @@ class SmoothingConfig(_Section):
         return self
 
 
-class MonitorConfig(EyeMonitorSettings, DrowsinessSettings, ProtocolSettings):
+class MonitorConfig(EyeMonitorSettings, DrowsinessSettings, NoticeSettings, ProtocolSettings):
     """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)

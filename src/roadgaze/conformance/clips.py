@@ -148,13 +148,17 @@ class ScenarioRenderer:
         mounting = mounting_for(scenario.mounting, self.cabin)
         yaw, camera_pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
         pitch = camera_pitch + self.facing_pitch_deg
+        worn = scenario.conditions
+        if scenario.worn_from and float(row[0]) < scenario.start_of(scenario.worn_from) - 1e-9:
+            worn = ()
         lean = (float(lean_m[0]), float(lean_m[1]), float(lean_m[2]))
-        key = tuple(round(float(v), 4) for v in (yaw, pitch, *row[3:6], mouth_open, *lean))
+        values = (yaw, pitch, *row[3:6], mouth_open, *lean, len(worn))
+        key = tuple(round(float(v), 4) for v in values)
         if key not in cache:
-            outfit = self.outfit(scenario.conditions)
+            outfit = self.outfit(worn)
             state = EyeState.both(float(row[3]), float(row[4]), float(row[5]))
             frame = outfit.render(yaw, pitch, state, mouth_open)
-            hand = self._hand(scenario.mounting) if "hand_at_12" in scenario.conditions else None
+            hand = self._hand(scenario.mounting) if "hand_at_12" in worn else None
             width_px = self.renderer.mesh.face_width_px
             frame = leaned(frame, width_px, mounting, lean, scenario.zoom)
             frame = frame if hand is None else hand.over(frame)

@@ -19,6 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from roadgaze.conformance.model import Scenario
+from roadgaze.conformance.notices import notice_key
 from roadgaze.monitor.protocols import Rule, euroncap
 
 SHEET = "DE - DM pred."
@@ -244,7 +245,12 @@ class GeneralRequirement:
 
 
 _INFORM = "Inform with visual and/or auditory cues of non functional system within 10 seconds"
-_NO_NOTICE = "no non-functional notice yet (its rule and scenario are still to come)"
+_NO_NOTICE = "no non-functional notice measured"
+_TOLD = "the service raised `non_functional` within 10 s of the condition's onset"
+_SHOWN = (
+    "while a notice lasts, every state message shows it (`monitor.non_functional`, "
+    "roadgaze.state/6) and the alert is raised again every 10 minutes (non_functional_repeat_s)"
+)
 GENERAL_REQUIREMENTS: tuple[GeneralRequirement, ...] = (
     GeneralRequirement(
         "Default ON at the start of every journey",
@@ -293,42 +299,56 @@ GENERAL_REQUIREMENTS: tuple[GeneralRequirement, ...] = (
         f"{_INFORM} after the driver obstructs the sensor by gripping the upper portion of the "
         "steering wheel",
         "notice: hand on the wheel at 12 o'clock",
+        (notice_key("hand_at_12"),),
+        basis=_TOLD,
         noise="Hand on wheel at 12 o'clock position",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         f"{_INFORM} after the driver wears a cap",
         "notice: cap",
+        (notice_key("cap"),),
+        basis=_TOLD,
         noise="Cap",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         f"{_INFORM} after the driver wears a hat",
         "notice: hat",
+        (notice_key("hat"),),
+        basis=_TOLD,
         noise="Hat",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         f"{_INFORM} after the driver wears dark sunglasses",
         "notice: dark sunglasses",
+        (notice_key("dark_sunglasses"),),
+        basis=_TOLD,
         noise="Dark sunglasses",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         f"{_INFORM} for a driver with long head hair fringe obscuring eyes",
         "notice: hair fringe",
+        (notice_key("fringe"),),
+        basis=_TOLD,
         noise="Long head hair fringe obscuring eyes",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         f"{_INFORM} for a driver with thick eyelash makeup",
         "notice: eyelash makeup",
+        (notice_key("eyelash_makeup"),),
+        basis=_TOLD,
         noise="Thick eyelash makeup",
         missing=_NO_NOTICE,
     ),
     GeneralRequirement(
         "Visual information about non-functional system shown permanently or every [10] minutes",
         "notice shown permanently or every 10 minutes",
+        (notice_key("dark_sunglasses"),),
+        basis=_SHOWN,
         missing=_NO_NOTICE,
     ),
 )

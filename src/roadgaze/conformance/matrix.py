@@ -234,6 +234,7 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
     """Every scenario, in report order."""
     from roadgaze.conformance.drowsiness import drowsiness_scenarios
     from roadgaze.conformance.locations import location_scenarios
+    from roadgaze.conformance.notices import notice_scenarios
     from roadgaze.conformance.timers import camera_scenarios, eye_scenarios, vats_scenarios
 
     return [
@@ -245,4 +246,6 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
         *location_scenarios(config),
         # Drowsiness (impairment): roadgaze.conformance.drowsiness.
         *drowsiness_scenarios(config),
+        # The non-functional notices (Euro NCAP general requirements).
+        *notice_scenarios(config),
     ]

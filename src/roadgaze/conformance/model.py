@@ -75,6 +75,9 @@ class Scenario:
     conditions: tuple[str, ...] = ()
     """What the driver wears and the camera meets, from the first frame: names of
     `roadgaze.synth.outfit.CONDITIONS` (`dark_sunglasses`, `night`, `mask`, `talking`, ...)."""
+    worn_from: str = ""
+    """The label of the segment from whose start the worn conditions (and the hand on the
+    wheel) are put on ('': from the first frame); `night` and `talking` hold throughout."""
     fast: bool = False
     """Part of the `--fast` subset (the test suite's)."""
     zoom: float = 1.0

@@ -161,16 +161,27 @@ def _quantiles_10_90(values: npt.NDArray[Any]) -> tuple[float, float]:
     return result[0], result[1]
 
 
+SKIN_BANDS = ((0.35, 0.6), (0.9, 1.2))
+"""Where the skin is measured below the eye, in eye widths below the lower lid: just below it,
+and on the cheek. The brighter median is the skin: large dark lenses cover the first band too
+(their frame reaches half an eye width below the lid), and against their own dark glass a lens's
+reflection reads as contrast."""
+
+
 def _skin_reference(image: npt.NDArray[Any], outline: _Outline, x0: int, x1: int) -> float:
-    """The median of the skin below the eye (a band 0.35-0.6 eye widths below the lower lid,
-    columns `x0:x1`), at least 1; NaN when the band is off the image."""
+    """The skin below the eye: the brighter median of the `SKIN_BANDS` (columns `x0:x1`), at
+    least 1; NaN when both bands are off the image."""
     lower_y, width = outline.lower_lid_y, outline.width_px
-    skin_y0 = max(0, int(lower_y + 0.35 * width))
-    skin_y1 = min(image.shape[0], int(lower_y + 0.6 * width) + 1)
-    skin = image[skin_y0:skin_y1, x0:x1]
-    if skin.size == 0:
+    medians = []
+    for top, bottom in SKIN_BANDS:
+        skin_y0 = max(0, int(lower_y + top * width))
+        skin_y1 = min(image.shape[0], int(lower_y + bottom * width) + 1)
+        skin = image[skin_y0:skin_y1, x0:x1]
+        if skin.size:
+            medians.append(_median(skin))
+    if not medians:
         return math.nan
-    return max(_median(skin), 1.0)
+    return max(*medians, 1.0)
 
 
 def _median(values: npt.NDArray[Any]) -> float:

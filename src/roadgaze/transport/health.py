@@ -17,6 +17,7 @@ from typing import Literal
 from roadgaze.capture import FrameSource
 from roadgaze.config import Config
 from roadgaze.monitor import initial_state, verdict_of
+from roadgaze.monitor.behaviours.non_functional import notice_in
 from roadgaze.mounting import CameraMounting
 from roadgaze.transport.keys import Keys
 from roadgaze.transport.messages import (
@@ -138,6 +139,8 @@ class Health:
             )
         if verdict.failure and not (eyes.degraded and verdict.failure == "eyes unjudgeable"):
             problems.append(f"temporary failure: {verdict.failure}")  # (the eyes: said above)
+        if notice := notice_in(verdict.outputs):
+            problems.append(f"not functional: {notice}")
         if self.permanent_failure:
             problems.append(f"permanent failure: {self.permanent_failure}")
         ambiguous = "" if record is None else record.sample.driver_ambiguous
@@ -191,6 +194,7 @@ class Health:
                 failure=verdict.failure,
                 phone_detection=phone is not None,
                 phone_use=None if phone is None else phone.phone_use,
+                non_functional=notice_in(verdict.outputs),
             ),
             config={
                 "monitor": monitor.model_dump(mode="json"),

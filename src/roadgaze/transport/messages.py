@@ -174,8 +174,9 @@ class AlertMessage(_Message):
     `degraded`, and the fields `closure_s`, `perclos` and `reason`; `roadgaze.alert/3` adds the
     kinds `temporary_failure` and `permanent_failure` (with the failure in `reason`) and the
     fields `rule` and `source`: the protocol rule the alert fired by and where that rule comes
-    from (docs/monitor.md, "Protocols"); `roadgaze.alert/4` adds the kind `phone_use` (a phone in
-    hand while moving, docs/phone.md). Every earlier field keeps its name and meaning.
+    from (docs/monitor.md, "Protocols"); `roadgaze.alert/4` adds the kinds `phone_use` (a phone
+    in hand while moving) and `non_functional` (the eyes or the face hidden while the camera
+    works; the condition in `reason`). Every earlier field keeps its name and meaning.
     """
 
     schema_id: Literal["roadgaze.alert/4"] = Field(default="roadgaze.alert/4", alias="schema")
@@ -333,6 +334,12 @@ class MonitorSnapshot(EyeFields):
         description="roadgaze.state/6: the last frame's phone judgement (null: it cannot judge, "
         "or phone detection is off).",
     )
+    non_functional: str = Field(
+        default="",
+        description="roadgaze.state/6: the non-functional notice in force ('' for none), with "
+        "its reason, e.g. 'eyes_hidden: eyes hidden facing the road (eyes hidden) 5.0 s'; "
+        "shown in every state message while it lasts (docs/monitor.md).",
+    )
 
 
 class StateMessage(_Message):
@@ -347,9 +354,10 @@ class StateMessage(_Message):
     failure in force, and the eye calibration (`eye_calibration`); `permanent_failure` (the
     camera gone past `permanent_failure_s`); and `alerts_waiting`, `alerts_lost` and
     `undelivered_alerts` to `transport` (the alert ledger). `roadgaze.state/5` adds
-    `driver_ambiguous`; `roadgaze.state/6` adds `phone_detection` and `phone_use` to `monitor`.
-    The monitor's angles are in the driver's frame (the camera mounting
-    applied). Every earlier field keeps its name and meaning.
+    `driver_ambiguous`; `roadgaze.state/6` adds `phone_detection`, `phone_use` and
+    `non_functional` to `monitor` (the non-functional notice in force, shown for as long as it
+    lasts). The monitor's angles are in the driver's frame (the camera mounting applied).
+    Every earlier field keeps its name and meaning.
     """
 
     schema_id: Literal["roadgaze.state/6"] = Field(default="roadgaze.state/6", alias="schema")

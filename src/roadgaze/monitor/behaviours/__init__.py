@@ -5,6 +5,7 @@ from roadgaze.monitor.behaviours.degraded import Degraded, DegradedState
 from roadgaze.monitor.behaviours.distraction import Distraction, DistractionState
 from roadgaze.monitor.behaviours.drowsy import Drowsy, DrowsyState
 from roadgaze.monitor.behaviours.eye_closure import CLOSURE_ALERTS, EyeClosure, EyeClosureState
+from roadgaze.monitor.behaviours.non_functional import NonFunctional, NonFunctionalState
 from roadgaze.monitor.behaviours.phone_use import PhoneUse, PhoneUseState
 from roadgaze.monitor.behaviours.temporary_failure import FailureState, TemporaryFailure
 from roadgaze.monitor.behaviours.unavailable import Unavailable, UnavailableState
@@ -24,6 +25,8 @@ __all__ = [
     "EyeClosure",
     "EyeClosureState",
     "FailureState",
+    "NonFunctional",
+    "NonFunctionalState",
     "PhoneUse",
     "PhoneUseState",
     "TemporaryFailure",

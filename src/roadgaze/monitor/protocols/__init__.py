@@ -21,6 +21,7 @@ from roadgaze.monitor.behaviours import (
     Distraction,
     Drowsy,
     EyeClosure,
+    NonFunctional,
     PhoneUse,
     TemporaryFailure,
     Unavailable,
@@ -59,6 +60,13 @@ TABLE: tuple[tuple[str, Behaviour[Any]], ...] = (
     ("euroncap", Unresponsive(euroncap.UNRESPONSIVE_AWAY, euroncap.UNRESPONSIVE_AFTER_WARNING)),
     # --- phone use (docs/phone.md) ---
     ("euroncap", PhoneUse(euroncap.PHONE_USE, euroncap.PHONE_GAP)),
+    # Non-functional notices (Euro NCAP general requirements).
+    (
+        "euroncap",
+        NonFunctional(
+            euroncap.NON_FUNCTIONAL, euroncap.NON_FUNCTIONAL_REPEAT, euroncap.NON_FUNCTIONAL_CLEAR
+        ),
+    ),
     (
         "roadgaze",
         TemporaryFailure(

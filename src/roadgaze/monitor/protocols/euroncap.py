@@ -19,6 +19,9 @@ __all__ = [
     "IMPAIRED",
     "LONG_DISTRACTION",
     "MICROSLEEP",
+    "NON_FUNCTIONAL",
+    "NON_FUNCTIONAL_CLEAR",
+    "NON_FUNCTIONAL_REPEAT",
     "PHONE_GAP",
     "PHONE_USE",
     "RULES",
@@ -120,6 +123,34 @@ DROWSINESS_SPEED = Rule(
     "(the rating calculator's general requirement)",
     "drowsiness warns only at this speed or above",
 )
+# Non-functional notices (roadgaze.monitor.behaviours.non_functional).
+_GENERAL = "Euro NCAP 2026 Safe Driving, Driver Engagement, DSM general requirements"
+NON_FUNCTIONAL = Rule(
+    "euroncap.non_functional",
+    "non_functional_after_s",
+    "s",
+    f"{_GENERAL}: inform of a non-functional system within 10 s (dark sunglasses, a cap, a hat, "
+    "a hair fringe, thick eyelash makeup, the sensor obstructed by a hand on the wheel); the "
+    "5 s default is roadgaze's choice",
+    "the eyes or the face hidden this long while facing the road: not functional",
+)
+NON_FUNCTIONAL_REPEAT = Rule(
+    "euroncap.non_functional.repeat",
+    "non_functional_repeat_s",
+    "s",
+    f"{_GENERAL}: visual information about a non-functional system shown permanently or every "
+    "10 minutes",
+    "a notice in force is raised again this often",
+)
+NON_FUNCTIONAL_CLEAR = Rule(
+    "euroncap.non_functional.clear",
+    "non_functional_clear_s",
+    "s",
+    "roadgaze's choice",
+    "the notice ends once the condition has been gone this long",
+)
+_NOTICES = (NON_FUNCTIONAL, NON_FUNCTIONAL_REPEAT, NON_FUNCTIONAL_CLEAR)
+
 _DISTRACTION = (ACTIVE, LONG_DISTRACTION, VATS, VATS_WINDOW, VATS_REARM)
 _UNRESPONSIVE = (UNRESPONSIVE_AFTER_WARNING, UNRESPONSIVE_AWAY, UNRESPONSIVE_CLOSED)
 # --- phone use ---
@@ -151,6 +182,7 @@ RULES = (
     DROWSINESS,
     DROWSINESS_SPEED,
     *_PHONE,
+    *_NOTICES,
 )
 
 

@@ -181,7 +181,9 @@ def test_state_is_degraded_while_the_eyes_have_been_unavailable_ten_seconds() ->
 def test_alerts_are_gated_on_the_speed_received(
     speed_payload: bytes | None, expected: int, source: str
 ) -> None:
-    speed = SpeedInput(timeout_s=5.0)
+    # A frozen clock: the speed received stays as fresh as it came however slowly the machine
+    # runs the 180 frames (a wall clock made it stale on a loaded machine).
+    speed = SpeedInput(timeout_s=5.0, clock=lambda: 0.0)
     if speed_payload is not None:
         speed.on_payload(speed_payload)
     link = FakeLink(speed=speed)

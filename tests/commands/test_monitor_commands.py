@@ -29,7 +29,7 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     new_fields = {"pitch_deg", "pitch_raw_deg", "roll_deg", "zone", "eyes_on_road"}
     assert new_fields | {"neutral_pitch_deg"} | yaw_fields <= set(schemas["yaw"]["required"])
     assert schemas["yaw"]["properties"]["schema"]["const"] == "roadgaze.yaw/3"
-    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/5"
+    assert schemas["state"]["properties"]["schema"]["const"] == "roadgaze.state/6"
     snapshot = schemas["state"]["$defs"]["MonitorSnapshot"]
     assert {"zone", "neutral_pitch_deg", "pitch_deg"} <= set(snapshot["required"])
     # yaw/3 and state/3 add the eyes; alert/2 the closure and drowsiness kinds
@@ -51,6 +51,8 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     # state/5: why the driver cannot be told from another face
     assert "driver_ambiguous" in schemas["state"]["required"]
     assert "permanent_failure" in schemas["state"]["required"]
+    # state/6: forward and lane support in the monitor
+    assert {"support_forward", "support_lane"} <= set(snapshot["required"])
 
 
 def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:

@@ -80,18 +80,19 @@ def test_noise_variables_are_functional_only_when_every_green_cell_passes_under_
     assert {name.removesuffix("__dark_sunglasses") for name in ran} == green
     night = dossier.noise_of("Daytime - Night-time")
     assert night is not None and night.performance == "Non Functional"
-    assert [name for name in runner.calls if name.endswith("__night")] == ["microsleep_70__night"]
+    assert [name for name in runner.calls if name.endswith("__night")] == ["mirror_left_70__night"]
     assert all(n.variable.variant is not None for n in dossier.noise)
 
 
 def test_a_noise_variable_stops_at_the_first_scenario_failing_under_it() -> None:
-    runner = FakeRunner(failing={"microsleep_70__dark_sunglasses"})
+    runner = FakeRunner(failing={"mirror_left_70__dark_sunglasses"})
     dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
     sunglasses = dossier.noise_of("Dark sunglasses")
     assert sunglasses is not None and not sunglasses.functional
-    assert sunglasses.why.startswith("microsleep_70__dark_sunglasses: FAIL: microsleep_70.warns")
+    failed = "mirror_left_70__dark_sunglasses: FAIL: mirror_left_70.support_forward"
+    assert sunglasses.why.startswith(failed)
     ran = [name for name in runner.calls if name.endswith("__dark_sunglasses")]
-    assert ran == ["microsleep_70__dark_sunglasses"]  # the shortest drive goes first
+    assert ran == ["mirror_left_70__dark_sunglasses"]  # the shortest drive goes first
 
 
 def test_general_requirements_answer_pass_fail_or_na_with_their_basis() -> None:

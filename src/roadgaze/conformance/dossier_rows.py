@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from roadgaze.conformance.model import Scenario
-from roadgaze.monitor.protocols import Rule, euroncap
+from roadgaze.monitor.protocols import Rule, euroncap, support
 
 SHEET = "DE - DM pred."
 """The prediction sheet's name in the template."""
@@ -147,7 +147,41 @@ _NON_TRANSIENT_ROWS = (
     _row(71, NON_TRANSIENT, "Sleep", "", "", (euroncap.SLEEP,), ("sleep_70.warns",), (), NA),
     _row(72, NON_TRANSIENT, "Unresponsive", "", "", UNRESPONSIVE, NA, NA, _UNRESPONSIVE),
 )
-ROWS: tuple[SheetRow, ...] = (*_LONG_ROWS, *_SHORT_ROWS, *_PHONE_ROWS, *_NON_TRANSIENT_ROWS)
+
+# Forward and lane support (roadgaze.conformance.support): the scenario whose support is judged
+# for each row, and the rules behind it. `support_forward` for the forward cell, `support_lane`
+# for the lane cell; the non-transient rows' one cell needs both.
+_SUPPORT_SCENARIOS = {
+    17: "side_{driver}_70",
+    18: "centre_stack_70",
+    21: "side_{passenger}_70",
+    26: "mirror_{driver}_4s_70",
+    28: "mirror_{passenger}_4s_70",
+    35: "vats_70",
+    39: "mirror_{driver}_70",
+    41: "mirror_{passenger}_70",
+    70: "microsleep_70",
+    71: "sleep_70",
+}
+_FORWARD, _LANE = support.support_rules(support.FORWARD), support.support_rules(support.LANE)
+
+
+def _with_support(row: SheetRow) -> SheetRow:
+    scenario = _SUPPORT_SCENARIOS.get(row.row)
+    if scenario is None:
+        return row
+    forward, lane = f"{scenario}.support_forward", f"{scenario}.support_lane"
+    warning, _, third = row.cells
+    if row.table == NON_TRANSIENT:
+        rules = (_FORWARD.impaired, _LANE.impaired)
+        return replace(row, rules=(*row.rules, *rules), cells=(warning, (forward, lane), third))
+    rules = (_FORWARD.off_road, _LANE.off_road)
+    return replace(row, rules=(*row.rules, *rules), cells=(warning, (forward,), (lane,)))
+
+
+ROWS: tuple[SheetRow, ...] = tuple(
+    _with_support(row) for row in (*_LONG_ROWS, *_SHORT_ROWS, *_PHONE_ROWS, *_NON_TRANSIENT_ROWS)
+)
 """Every row of the sheet that takes a prediction, in sheet order."""
 
 

@@ -232,12 +232,16 @@ def preset_scenarios(config: MonitorConfig) -> list[Scenario]:
 
 def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
     """Every scenario, in report order."""
+    from roadgaze.conformance.support import support_scenarios, with_support
     from roadgaze.conformance.timers import camera_scenarios, eye_scenarios, vats_scenarios
 
-    return [
+    scenarios = [
         *distraction_scenarios(config),
         *vats_scenarios(config),
         *eye_scenarios(config),
         *camera_scenarios(config),
         *preset_scenarios(config),
     ]
+    # Forward and lane support: judged on the scenarios of roadgaze.conformance.support.SUPPORTED,
+    # and the long mirror looks of its own.
+    return [*with_support(config, scenarios), *support_scenarios(config)]

@@ -17,6 +17,7 @@ from typing import Literal
 from roadgaze.capture import FrameSource
 from roadgaze.config import Config
 from roadgaze.monitor import initial_state, verdict_of
+from roadgaze.monitor.protocols.support import FORWARD, LANE
 from roadgaze.mounting import CameraMounting
 from roadgaze.transport.keys import Keys
 from roadgaze.transport.messages import (
@@ -27,6 +28,7 @@ from roadgaze.transport.messages import (
     TransportStatus,
 )
 from roadgaze.transport.publisher import MessageLink
+from roadgaze.transport.support_message import SupportLevel
 from roadgaze.types import Alert, Frame, FrameRecord
 
 ALERT_LOG = "roadgaze.daemon"
@@ -188,6 +190,8 @@ class Health:
                 distraction_warn_s=verdict.distraction_warn_s,
                 distraction_rule=verdict.distraction_rule,
                 failure=verdict.failure,
+                support_forward=SupportLevel.of(verdict, FORWARD),
+                support_lane=SupportLevel.of(verdict, LANE),
             ),
             config={
                 "monitor": monitor.model_dump(mode="json"),

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
+from roadgaze.transport.message_base import Message as _Message
+from roadgaze.transport.support_message import SupportLevel, SupportMessage
 from roadgaze.types import (
     Alert,
     AlertKind,
@@ -25,20 +27,7 @@ from roadgaze.types import (
 
 YAW_SCHEMA = "roadgaze.yaw/3"
 ALERT_SCHEMA = "roadgaze.alert/3"
-STATE_SCHEMA = "roadgaze.state/5"
-
-
-class _Message(BaseModel):
-    model_config = ConfigDict(
-        frozen=True,
-        populate_by_name=True,
-        extra="forbid",
-        json_schema_serialization_defaults_required=True,  # every field is always published
-        allow_inf_nan=False,  # JSON has no NaN or Infinity; a message holding one is refused
-    )
-
-    def to_json_bytes(self) -> bytes:
-        return self.model_dump_json(by_alias=True).encode("utf-8")
+STATE_SCHEMA = "roadgaze.state/6"
 
 
 class EyeFields(_Message):
@@ -237,10 +226,12 @@ class TransportStatus(_Message):
     routers: int = 0
     session_reopens: int = 0
     yaw_sent: int = 0
+    support_sent: int = Field(default=0, description="roadgaze.state/6: support messages sent.")
     vss_sent: int = Field(default=0, description="COVESA VSS values published.")
     alerts_sent: int = Field(default=0, description="Alerts published while the link was up.")
     not_sent: int = Field(
-        default=0, description="yaw_not_sent + VSS values not sent + alerts_failed."
+        default=0,
+        description="yaw_not_sent + support and VSS values not sent + alerts_failed.",
     )
     pending_alerts: int = Field(
         default=0, description="Client mode: alerts held by roadgaze until the session opens."
@@ -321,6 +312,13 @@ class MonitorSnapshot(EyeFields):
         description="none, learning or calibrated: the eyes move the gaze only once the "
         "driver's resting eye direction is learned (calibrated).",
     )
+    support_forward: SupportLevel = Field(
+        default_factory=SupportLevel,
+        description="roadgaze.state/6: forward support at the last frame (the support message).",
+    )
+    support_lane: SupportLevel = Field(
+        default_factory=SupportLevel, description="roadgaze.state/6: lane support, likewise."
+    )
 
 
 class StateMessage(_Message):
@@ -335,11 +333,13 @@ class StateMessage(_Message):
     failure in force, and the eye calibration (`eye_calibration`); `permanent_failure` (the
     camera gone past `permanent_failure_s`); and `alerts_waiting`, `alerts_lost` and
     `undelivered_alerts` to `transport` (the alert ledger). `roadgaze.state/5` adds
-    `driver_ambiguous`. The monitor's angles are in the driver's frame (the camera mounting
-    applied). Every earlier field keeps its name and meaning.
+    `driver_ambiguous`; `roadgaze.state/6` adds forward and lane support to `monitor`
+    (`support_forward`, `support_lane`: the support message's levels) and `support_sent` to
+    `transport`. The monitor's angles are in the driver's frame (the camera mounting applied).
+    Every earlier field keeps its name and meaning.
     """
 
-    schema_id: Literal["roadgaze.state/5"] = Field(default="roadgaze.state/5", alias="schema")
+    schema_id: Literal["roadgaze.state/6"] = Field(default="roadgaze.state/6", alias="schema")
     vehicle_id: str
     wall_time: float
     status: Literal["starting", "running", "degraded", "stopping", "stopped"]
@@ -368,6 +368,7 @@ MESSAGE_MODELS: dict[str, type[_Message]] = {
     "yaw": YawMessage,
     "alert": AlertMessage,
     "state": StateMessage,
+    "support": SupportMessage,
 }
 
 

@@ -5,6 +5,7 @@ from roadgaze.monitor.behaviours.degraded import Degraded, DegradedState
 from roadgaze.monitor.behaviours.distraction import Distraction, DistractionState
 from roadgaze.monitor.behaviours.drowsy import Drowsy, DrowsyState
 from roadgaze.monitor.behaviours.eye_closure import CLOSURE_ALERTS, EyeClosure, EyeClosureState
+from roadgaze.monitor.behaviours.support import Support, SupportState
 from roadgaze.monitor.behaviours.temporary_failure import FailureState, TemporaryFailure
 from roadgaze.monitor.behaviours.unavailable import Unavailable, UnavailableState
 from roadgaze.monitor.behaviours.unresponsive import Unresponsive, UnresponsiveState
@@ -23,6 +24,8 @@ __all__ = [
     "EyeClosure",
     "EyeClosureState",
     "FailureState",
+    "Support",
+    "SupportState",
     "TemporaryFailure",
     "Unavailable",
     "UnavailableState",

@@ -86,9 +86,15 @@ MICROSLEEP = Rule(
     "s",
     f"{_DSM}: microsleep, a closure shorter than 3 s (roadgaze warns from 1 s)",
     "eyes closed this long",
+    impairment=True,
 )
 SLEEP = Rule(
-    "euroncap.sleep", "sleep_s", "s", f"{_DSM}: sleep, a closure longer than 3 s", "closed"
+    "euroncap.sleep",
+    "sleep_s",
+    "s",
+    f"{_DSM}: sleep, a closure longer than 3 s",
+    "closed",
+    impairment=True,
 )
 IMPAIRED = Rule(
     "euroncap.impaired_monitoring",

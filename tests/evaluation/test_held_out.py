@@ -85,14 +85,17 @@ def test_forward_support_must_go_from_normal_to_heightened_within_half_a_second(
     assert failed([heightened] * 70) == "support heightened before the look"
 
 
-def check(result: CaseResult) -> None:
+def check(result: CaseResult, support: bool = True) -> None:
+    """The case passed; with `support`, forward support was raised within 0.5 s too (measured
+    in process: `run_case`)."""
     alerts = [(round(t, 2), kind) for t, kind, _ in result.alerts]
     print(f"subject {result.subject} {result.case.name}: warned at {result.warn_s}, {alerts}")
     assert result.passed, (
         f"{result.why_failed}: yaw {result.look_yaw_deg}, zones {set(result.look_zones)}, "
         f"alerts {result.alerts}"
     )
-    assert not result.support_failed, result.support_failed  # every look leaves the road
+    if support:  # every look leaves the road
+        assert not result.support_failed, result.support_failed
 
 
 @pytest.mark.slow
@@ -178,4 +181,4 @@ def test_replay_publish_with_the_speed_on_the_bus(
     records = [json.loads(line) for line in out.read_text().splitlines()]
     alerts = [(a["t_s"], a["kind"], a["reason"]) for a in bus.alerts]
     zones, yaws = [r["zone"] for r in records], [r["yaw_deg"] for r in records]
-    check(result_of(stills[subject], case, look_t_s, alerts, zones, yaws))
+    check(result_of(stills[subject], case, look_t_s, alerts, zones, yaws), support=False)

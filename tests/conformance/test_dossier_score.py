@@ -37,9 +37,10 @@ def test_without_the_pinned_calculator_one_line_says_how_to_install_it(
 
 @pytest.mark.slow
 def test_the_calculator_pays_the_rows_whose_tests_pass_again(tmp_path: Path) -> None:
-    """Microsleep and sleep warnings (0.5 each) and the unresponsive driver's emergency function
-    (2.0) are the GREEN rows whose whole group is GREEN: 3 points with the gates taken as met;
-    a sleep test failing when run again takes its 0.5."""
+    """Microsleep and sleep warnings (0.5 each) with their forward and lane support (1.5 each)
+    and the unresponsive driver's emergency function (2.0) are the GREEN rows whose whole group
+    is GREEN: 6 points with the gates taken as met; a sleep test failing when run again takes
+    its points."""
     pytest.importorskip("euroncap_rating_2026", reason="needs roadgaze[euroncap]")
     assert require_calculator() == dossier_score.PINNED
     template = Calculator(tmp_path / "template").template()
@@ -48,12 +49,12 @@ def test_the_calculator_pays_the_rows_whose_tests_pass_again(tmp_path: Path) -> 
 
     runner = FakeRunner()
     passed = score(dossier, path, Calculator(tmp_path / "pass"), SCENARIOS, runner, True)
-    assert passed.score.points == 3.0 and passed.score.max_points == 25.0
-    assert {(a.column, a.row, a.value) for a in passed.answers} == {
-        ("D", 70, "PASS"),
-        ("D", 71, "PASS"),
-        ("F", 72, "PASS"),
-    }
+    assert passed.score.points == 6.0 and passed.score.max_points == 25.0
+    answers = {(a.column, a.row, a.value) for a in passed.answers}
+    assert {("D", 70, "PASS"), ("D", 71, "PASS"), ("F", 72, "PASS")} < answers
+    # one of the GREEN microsleep/sleep supports, drawn at random
+    assert len(answers - {("D", 70, "PASS"), ("D", 71, "PASS"), ("F", 72, "PASS")}) == 1
+    assert answers & {("E", 70, "PASS"), ("E", 71, "PASS")}
     assert set(runner.calls) == {
         "microsleep_70",
         "sleep_70",
@@ -66,7 +67,7 @@ def test_the_calculator_pays_the_rows_whose_tests_pass_again(tmp_path: Path) -> 
 
     failing = FakeRunner(failing={"sleep_70"})
     failed = score(dossier, path, Calculator(tmp_path / "fail"), SCENARIOS, failing, True)
-    assert failed.score.points == 2.5
+    assert failed.score.points < passed.score.points
     sleep = next(a for a in failed.answers if a.row == 71)
     assert sleep.value == "FAIL" and sleep.why.startswith("sleep_70: FAIL: sleep_70.warns")
     assert (tmp_path / "fail" / "sd_verified.xlsx").is_file() and failed.report.is_file()

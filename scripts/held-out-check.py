@@ -64,6 +64,9 @@ def main() -> int:
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         results = list(pool.map(_run, jobs))
     for r in results:
+        if r.support_failed:
+            where = f"subject {r.subject} series {r.series} {r.case.name}"
+            print(f"SUPPORT {where}: {r.support_failed}")
         if not r.passed:
             zones = sorted({z for z in r.look_zones}, key=str)
             yaw = "-" if r.look_yaw_deg is None else f"{r.look_yaw_deg:.1f}"
@@ -72,7 +75,10 @@ def main() -> int:
                 f"FAIL subject {r.subject} series {r.series} {r.case.name}: {r.why_failed}; "
                 f"yaw {yaw}, zones {zones}; alerts [{alerts}]"
             )
-    print(f"\n{'case':24} {'pass':>7}  warning s after the look's start (median, min-max)")
+    print(
+        f"\n{'case':24} {'pass':>7}  warning s after the look's start (median, min-max); "
+        "forward support raised within 0.5 s"
+    )
     failed = 0
     for case in cases:
         mine = [r for r in results if r.case == case]
@@ -84,7 +90,8 @@ def main() -> int:
             if times
             else "-"
         )
-        print(f"{case.name:24} {passed:>3}/{len(mine):<3}  {span}")
+        supported = sum(not r.support_failed for r in mine)
+        print(f"{case.name:24} {passed:>3}/{len(mine):<3}  {span}; support {supported}/{len(mine)}")
     total = len(results)
     print(f"{'all':24} {total - failed:>3}/{total:<3}")
     return 1 if failed else 0

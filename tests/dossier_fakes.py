@@ -50,7 +50,7 @@ class FakeRunner:
         return outcomes_of(scenarios, failed)
 
 
-def failing_under(*conditions: str, scenario: str = "microsleep_70") -> set[str]:
+def failing_under(*conditions: str, scenario: str = "mirror_left_70") -> set[str]:
     """`scenario` (the shortest GREEN drive, run first) under each of `conditions`: a
     `FakeRunner` failing these shows those noise variables not functional."""
     return {f"{scenario}__{condition}" for condition in conditions}

@@ -23,6 +23,7 @@ from roadgaze.config import MonitorConfig
 from roadgaze.monitor import initial_state, verdict_of
 from roadgaze.pose.geometry import forward_model
 from roadgaze.transport import AlertMessage, SpeedInput, TransportStatus, YawMessage
+from roadgaze.transport.support_message import SupportMessage
 from roadgaze.types import (
     Alert,
     ClosesOnExit,
@@ -222,6 +223,7 @@ class FakeLink:
 
     yaw: list[YawMessage] = field(default_factory=list)
     alerts: list[AlertMessage] = field(default_factory=list)
+    support: list[SupportMessage] = field(default_factory=list)
     connected: bool = True
     speed: SpeedInput | None = None
 
@@ -230,6 +232,9 @@ class FakeLink:
 
     def publish_alert(self, message: AlertMessage) -> None:
         self.alerts.append(message)
+
+    def publish_support(self, message: SupportMessage) -> None:
+        self.support.append(message)
 
     def status(self) -> TransportStatus:
         return TransportStatus(mode="peer", session_open=True, connected=self.connected)

@@ -319,7 +319,8 @@ class Verdict:
     angles are in the driver's frame: roadgaze.mounting); None: the same as the neutral."""
     outputs: tuple[Output, ...] = ()
     """The monitor behaviours' per-frame outputs that are not alerts (roadgaze.monitor.events
-    `Publish`), in the order the behaviours ran; none today."""
+    `Publish`), in the order the behaviours ran: `support_forward` and `support_lane`
+    (roadgaze.monitor.behaviours.support)."""
 
     @property
     def eyes_on_road(self) -> bool | None:

@@ -64,7 +64,7 @@ def test_replay_mcap_holds_one_record_per_frame_in_time_order_and_decodable_imag
     contents = read_mcap(mcap)
     assert set(contents.schemas.values()) >= {
         "foxglove.CompressedImage", "foxglove.ImageAnnotations", "roadgaze.record",
-        "roadgaze.limits", "roadgaze.alert/4", "roadgaze.state/6",
+        "roadgaze.limits", "roadgaze.alert/4", "roadgaze.state/6", "roadgaze.support/1",
     }  # fmt: skip
     records = contents.json(TOPIC_RECORD)
     streamed = [{**line, **dict.fromkeys(OFFLINE_FIELDS)} for line in lines]

@@ -13,10 +13,10 @@ from roadgaze.commands.listen import _vehicle_of, format_pretty
 pytestmark = pytest.mark.usefixtures("restore_logging")
 
 
-def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> None:
+def test_schema_prints_every_schema(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["schema"]) == 0
     schemas = json.loads(capsys.readouterr().out)
-    assert sorted(schemas) == ["alert", "state", "yaw"]
+    assert sorted(schemas) == ["alert", "state", "support", "yaw"]
     for schema in schemas.values():
         jsonschema.Draft202012Validator.check_schema(schema)
     required = set(schemas["alert"]["required"])
@@ -51,6 +51,8 @@ def test_schema_prints_all_three_schemas(capsys: pytest.CaptureFixture[str]) -> 
     # state/5: why the driver cannot be told from another face
     assert "driver_ambiguous" in schemas["state"]["required"]
     assert "permanent_failure" in schemas["state"]["required"]
+    # state/6: forward and lane support in the monitor
+    assert {"support_forward", "support_lane"} <= set(snapshot["required"])
 
 
 def test_schema_of_one_message(capsys: pytest.CaptureFixture[str]) -> None:

@@ -58,13 +58,13 @@ def test_a_run_writes_the_dossier_and_prints_the_official_score(
     out = capsys.readouterr().out
     assert code == 0
     ws = openpyxl.load_workbook(dossier)["DE - DM pred."]
-    assert [ws[c].value for c in ("D70", "E70", "D71", "F72")] == ["Green", "Red", "Red", "Red"]
+    assert [ws[c].value for c in ("D70", "E70", "D71", "F72")] == ["Green", "Green", "Red", "Red"]
     # Measured: behind dark lenses the eyes are not judged, so the microsleep goes unwarned;
     # at night (the infrared picture) it is warned as by day.
     assert ws["D4"].value == "Non Functional" and ws["D2"].value == "Functional"
     assert "| 71 | Sleep | RED (not run: sleep_70.warns) |" in out
     assert "\nDriver Monitoring: 0 / 25 points\n" in out
-    assert "the rows alone, were those met: 0.5 / 25 (Non-transient - Microsleep 0.5)" in out
+    assert "the rows alone, were those met: 2 / 25 (Non-transient - Microsleep 2)" in out
     assert "Assumed: forward and lane support count the service's support request" in out
     assert (tmp_path / "dossier.md").is_file()
     reports = sorted((tmp_path / "euroncap").glob("sd_*_report.xlsx"))

@@ -36,7 +36,11 @@ def test_the_measured_sheet_shows_each_cell_with_what_was_measured() -> None:
     dossier = judge(outcomes, SCENARIOS, FakeRunner(), "lhd")
     text = dossier_markdown(dossier)
     assert "| 70 | Microsleep | GREEN (PASS: microsleep_70.warns 1.00 s, " in text
-    assert "| 71 | Sleep | RED (FAIL: sleep_70.warns 3.00 s (FAIL)) | RED (no scenario" in text
+    assert (
+        "| 71 | Sleep | RED (FAIL: sleep_70.warns 3.00 s (FAIL)) | GREEN (PASS: "
+        "sleep_70.support_forward 0.50 s, sleep_70.support_lane 0.50 s) |" in text
+    )  # forward and lane support measured beside the warning
+    assert "| GREEN (PASS: mirror_left_70.support_forward 0.50 s) |" in text
     assert "| 26 | Driving task / Owl / Driver side mirror | n/a |" in text
     assert "| 4 | Dark sunglasses | Functional |" in text
 

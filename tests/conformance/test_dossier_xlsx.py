@@ -81,7 +81,7 @@ def test_the_filled_sheet_holds_the_dossiers_values(tmp_path: Path) -> None:
     dossier = judge(outcomes_of(scenarios, failed=("sleep_70.warns",)), scenarios, runner, "lhd")
     out = write_dossier(template(), dossier, tmp_path / "d.xlsx")
     ws = openpyxl.load_workbook(out)[SHEET]
-    assert [ws[c].value for c in ("D17", "E17", "F17", "D69")] == ["Green", "Red", "Red", "Red"]
+    assert [ws[c].value for c in ("D17", "E17", "F17", "D69")] == ["Green"] * 3 + ["Red"]
     assert [ws[c].value for c in ("D70", "D71", "F72", "D26", "F68", "D68", "D69")] == [
         "Green",
         "Red",
@@ -94,7 +94,7 @@ def test_the_filled_sheet_holds_the_dossiers_values(tmp_path: Path) -> None:
     assert ws["D2"].value == "Non Functional" and ws["D4"].value == "Non Functional"
     assert ws["D3"].value == "Functional"  # clear sunglasses: every GREEN cell passed under them
     greens = sum(c.value == "Green" for row in ws["D17:F72"] for c in row)
-    # Warnings of rows 17-25, 35-38, 47, 68 (drowsiness) and 70, 72's emergency function
-    # (sleep_70 failed).
-    assert greens == sum(c.colour == "Green" for c in dossier.cells) == 17
+    # 17 warnings (rows 17-25, 35-38, 47, 68, 70 and 72's emergency function; sleep_70 failed),
+    # forward and lane support of rows 17-26, 28, 35-39, 41 and 47, microsleep's and sleep's
+    assert greens == sum(c.colour == "Green" for c in dossier.cells) == 17 + 18 * 2 + 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d.xlsx"]

@@ -34,7 +34,11 @@ def test_fast_suite_passes_with_the_acceptance_cases(
     failed = [o for o in report["outcomes"] if o["result"] != "PASS"]
     assert code == 0 and failed == [], failed
     assert report["protocol"] == "both" and 6 <= report["scenarios"] <= 10
-    by_scenario = {o["scenario"]: o for o in report["outcomes"]}
+    # each scenario's first requirement (the warning); forward and lane support follow it
+    by_scenario = {o["scenario"]: o for o in reversed(report["outcomes"])}
+    support = [o for o in report["outcomes"] if o["requirement"].endswith(".support_forward")]
+    assert {o["scenario"] for o in support} >= {"lap_70", "side_left_70", "mirror_left_70"}
+    assert all(0.0 <= o["measured_s"] <= 0.5 for o in support)
     for name, window in ACCEPTANCE.items():
         outcome = by_scenario[name]
         if window is None:

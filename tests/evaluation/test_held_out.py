@@ -29,6 +29,7 @@ from roadgaze.evaluation.held_out import (
     load_stills,
     result_of,
     run_case,
+    with_support,
     write_clip,
 )
 from zenoh_helpers import endpoint, free_port, router, stop_process, wait_for
@@ -69,13 +70,32 @@ def test_the_verdict_of_a_case_from_its_alerts() -> None:
     assert verdict("left_mirror45_1.5s_70", [(5.0, "vats", "")]) == "raised vats"
 
 
-def check(result: CaseResult) -> None:
+def test_forward_support_must_go_from_normal_to_heightened_within_half_a_second() -> None:
+    someone = Stills(0, 1, {})
+    base = result_of(someone, CASE["left_mirror45_1.5s_70"], 4.0, [], ["road"] * 120, [0.0] * 120)
+
+    def failed(levels: list[str]) -> str:
+        return with_support(base, 4.0, levels).support_failed
+
+    normal, heightened = "normal", "heightened"
+    assert failed([normal] * 60 + [normal, heightened] + [heightened] * 10) == ""
+    assert with_support(base, 4.0, [normal] * 61 + [heightened] * 2).support_s == 1 / 15
+    assert failed([normal] * 60 + [normal] * 8 + [heightened]) == "support raised at 0.53 s"
+    assert failed([normal] * 70) == "support not raised"
+    assert failed([heightened] * 70) == "support heightened before the look"
+
+
+def check(result: CaseResult, support: bool = True) -> None:
+    """The case passed; with `support`, forward support was raised within 0.5 s too (measured
+    in process: `run_case`)."""
     alerts = [(round(t, 2), kind) for t, kind, _ in result.alerts]
     print(f"subject {result.subject} {result.case.name}: warned at {result.warn_s}, {alerts}")
     assert result.passed, (
         f"{result.why_failed}: yaw {result.look_yaw_deg}, zones {set(result.look_zones)}, "
         f"alerts {result.alerts}"
     )
+    if support:  # every look leaves the road
+        assert not result.support_failed, result.support_failed
 
 
 @pytest.mark.slow
@@ -161,4 +181,4 @@ def test_replay_publish_with_the_speed_on_the_bus(
     records = [json.loads(line) for line in out.read_text().splitlines()]
     alerts = [(a["t_s"], a["kind"], a["reason"]) for a in bus.alerts]
     zones, yaws = [r["zone"] for r in records], [r["yaw_deg"] for r in records]
-    check(result_of(stills[subject], case, look_t_s, alerts, zones, yaws))
+    check(result_of(stills[subject], case, look_t_s, alerts, zones, yaws), support=False)

@@ -65,7 +65,7 @@ def test_the_table_runs_each_protocols_behaviours_in_order_clearing_last(
 ) -> None:
     names = [type(b).__name__ for b in behaviours(protocol)]
     ncap = ["Unresponsive", "PhoneUse", "NonFunctional"] if protocol != "addw" else []
-    assert names == [*expected, *ncap, "TemporaryFailure", "Clearing"]
+    assert names == [*expected, *ncap, "TemporaryFailure", "Support", "Support", "Clearing"]
     assert isinstance(behaviours(protocol)[-1], Clearing)
 
 
@@ -113,9 +113,13 @@ def test_published_outputs_land_in_the_verdict_of_that_frame_only() -> None:
     assert monitor.verdict.outputs == ()
     monitor.update(sample(0.0))
     monitor.update(sample(0.1))
-    assert monitor.verdict.outputs == (
+    beacons = tuple(o for o in monitor.verdict.outputs if o.name == "beacon")
+    assert beacons == (
         Output("beacon", "1", "roadgaze.clear", "roadgaze's choice", "counting", 0.1),
     )
+    # the support outputs come first (their behaviours run before the beacon)
+    names = [o.name for o in monitor.verdict.outputs]
+    assert names == ["support_forward", "support_lane", "beacon"]
     assert Monitor(config).verdict.outputs == ()
 
 

@@ -186,7 +186,7 @@ def test_under_euroncap_drowsiness_warns_from_50_kmh_and_at_unknown_speed() -> N
     assert step(None, moving=False) == []  # standing still: never
     # Under ADDW alone, whenever moving (ADDW's lowest speed decides).
     assert len(step(30.0, protocol="addw")) == 1
-    assert euroncap.DROWSINESS.until_trip_end and not euroncap.DROWSINESS_SPEED.until_trip_end
+    assert euroncap.DROWSINESS.impairment and not euroncap.DROWSINESS_SPEED.impairment
 
 
 def nod_drive(speed_kmh: float | None) -> list[tuple[str, float, str]]:

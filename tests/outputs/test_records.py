@@ -129,3 +129,41 @@ def test_the_hands_and_the_phone_judgement_in_the_record() -> None:
     assert (fields["phone_hand"], fields["phone_pose"]) == ("right", "ear")
     off = record_fields(RECORDS[1])  # the hand stage off: every hand field null
     assert all(off[name] is None for name, _ in HAND_SCHEMA)
+
+
+def test_the_record_carries_forward_and_lane_support_and_writes_them_as_csv(
+    tmp_path: Any,
+) -> None:
+    import csv
+
+    from fakes import eyes_of
+    from roadgaze.config import MonitorConfig
+    from roadgaze.monitor import Monitor
+    from roadgaze.outputs import CsvWriter
+    from roadgaze.outputs.records import alert_row, record_fields
+    from roadgaze.types import FrameRecord
+
+    monitor = Monitor(MonitorConfig(neutral_yaw_deg=0.0))
+    records = []
+    for frame in range(75):  # 3 s ahead, then 2 s at the left mirror, at 15 fps and 70 km/h
+        t_s = frame / 15
+        yaw_deg = 35.0 if t_s >= 3.0 - 1e-9 else 0.0
+        sample = PoseSample(t_s, frame, True, yaw_deg, yaw_deg, 0.0, 1.0, eyes=eyes_of())
+        alerts = monitor.update(sample, 70.0)
+        records.append(FrameRecord(sample, monitor.verdict, alerts))
+    fields = [record_fields(r) for r in records]
+    levels = [(f["support_forward"], f["support_lane"]) for f in fields]
+    assert levels[29] == ("heightened", "heightened")  # not yet watched the road 2 s
+    assert levels[30] == levels[44] == ("normal", "normal")  # 2.0 s
+    assert levels[45] == ("heightened", "heightened")  # 3.0 s: the mirror look's first frame
+    verdict = dataclasses.replace(records[0].verdict, outputs=())
+    assert record_fields(dataclasses.replace(records[0], verdict=verdict))["support_lane"] is None
+    path = tmp_path / "drive.csv"
+    with CsvWriter(path) as writer:
+        for record in records:
+            writer.on_record(record, None)  # type: ignore[arg-type]
+    with path.open(newline="", encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [row["support_forward"] for row in rows] == [level for level, _ in levels]
+    assert [row["support_lane"] for row in rows] == [level for _, level in levels]
+    assert alert_row(ALERTS[0])["support_forward"] is None  # an alert of its own: no frame

@@ -68,7 +68,7 @@ def test_keys_and_text() -> None:
         b"12.5",
         b"0.0",
     )
-    assert len(VSS_PATHS) == 11
+    assert len(VSS_PATHS) == 13  # VSS 6.0 signals and roadgaze's support overlay (2)
 
 
 @pytest.mark.parametrize(

@@ -114,7 +114,9 @@ def run(args: argparse.Namespace, config: Config) -> int:
     def progress(scenario: Any, outcomes: list[Any]) -> None:
         verdict = "PASS" if all(o.passed for o in outcomes) else "FAIL"
         measured = ", ".join(
-            "none" if o.measured_s is None else f"{o.measured_s:.2f} s" for o in outcomes
+            f"{o.requirement.key.rpartition('.')[2]} "
+            + ("none" if o.measured_s is None else f"{o.measured_s:.2f} s")
+            for o in outcomes
         )
         log.info("conformance: %s %s (%s)", verdict, scenario.name, measured)
 

@@ -8,13 +8,13 @@ from typing import Any
 
 from roadgaze.config import Config
 
-NAMES = ("yaw", "alert", "state")
+NAMES = ("yaw", "alert", "state", "support")
 
 
 def register(subparsers: Any) -> None:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         "schema",
-        help="print the JSON Schemas of the yaw, alert and state messages",
+        help="print the JSON Schemas of the yaw, alert, state and support messages",
         description="Print the JSON Schema (draft 2020-12, from the pydantic models) of the "
         "messages published under vehicle/<id>/dms/: all of them as one object keyed by name, "
         "or the one named.",

@@ -25,6 +25,7 @@ from roadgaze.config.notices import NoticeSettings
 from roadgaze.config.protocol import ProtocolSettings
 from roadgaze.config.record import RecordConfig
 from roadgaze.config.section import Section as _Section
+from roadgaze.config.support import SupportSettings
 from roadgaze.config.zenoh import ZenohConfig
 from roadgaze.config.zones import ZoneConfig, check_area1, default_zones, mirrored_zones
 from roadgaze.errors import ConfigError
@@ -163,7 +164,9 @@ class SmoothingConfig(_Section):
         return self
 
 
-class MonitorConfig(EyeMonitorSettings, DrowsinessSettings, NoticeSettings, ProtocolSettings):
+class MonitorConfig(
+    EyeMonitorSettings, DrowsinessSettings, NoticeSettings, ProtocolSettings, SupportSettings
+):
     """Inattention monitor thresholds and glance zones (defaults and sources: docs/monitor.md)."""
 
     road_half_width_deg: float = Field(default=25.0, gt=0)

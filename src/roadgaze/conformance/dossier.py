@@ -96,7 +96,8 @@ class Dossier:
         if held:
             gates.append(f"mandatory noise variables not shown functional: {', '.join(held)}")
         if failed:
-            gates.append(f"{len(failed)} general requirements not met: {'; '.join(failed)}")
+            noun = "requirement" if len(failed) == 1 else "requirements"
+            gates.append(f"{len(failed)} general {noun} not met: {'; '.join(failed)}")
         return gates
 
 

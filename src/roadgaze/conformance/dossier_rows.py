@@ -20,7 +20,7 @@ from dataclasses import dataclass, replace
 
 from roadgaze.conformance.model import Scenario
 from roadgaze.conformance.notices import notice_key
-from roadgaze.monitor.protocols import Rule, euroncap
+from roadgaze.monitor.protocols import Rule, euroncap, support
 
 SHEET = "DE - DM pred."
 """The prediction sheet's name in the template."""
@@ -172,7 +172,51 @@ _NON_TRANSIENT_ROWS = (
     _row(71, NON_TRANSIENT, "Sleep", "", "", (euroncap.SLEEP,), ("sleep_70.warns",), (), NA),
     _row(72, NON_TRANSIENT, "Unresponsive", "", "", UNRESPONSIVE, NA, NA, _UNRESPONSIVE),
 )
-ROWS: tuple[SheetRow, ...] = (*_LONG_ROWS, *_SHORT_ROWS, *_PHONE_ROWS, *_NON_TRANSIENT_ROWS)
+
+# Forward and lane support (roadgaze.conformance.support): the scenario whose support is judged
+# for each row, and the rules behind it. `support_forward` for the forward cell, `support_lane`
+# for the lane cell; the non-transient rows' one cell needs both.
+_SUPPORT_SCENARIOS = {
+    17: "side_{driver}_70",
+    18: "centre_stack_70",
+    19: "owl_passenger_footwell_70",
+    20: "owl_passenger_face_70",
+    21: "side_{passenger}_70",
+    22: "lizard_infotainment_70",
+    23: "lizard_glovebox_70",
+    24: "lean_passenger_footwell_70",
+    25: "lean_rear_passenger_70",
+    26: "mirror_{driver}_4s_70",
+    28: "mirror_{passenger}_4s_70",
+    35: "vats_70",
+    36: "vats_owl_passenger_footwell_70",
+    37: "vats_lizard_infotainment_70",
+    38: "vats_lizard_passenger_footwell_70",
+    39: "mirror_{driver}_70",
+    41: "mirror_{passenger}_70",
+    47: "vats_lizard_multi_target_70",
+    70: "microsleep_70",
+    71: "sleep_70",
+}
+_FORWARD, _LANE = support.support_rules(support.FORWARD), support.support_rules(support.LANE)
+
+
+def _with_support(row: SheetRow) -> SheetRow:
+    scenario = _SUPPORT_SCENARIOS.get(row.row)
+    if scenario is None:
+        return row
+    forward, lane = f"{scenario}.support_forward", f"{scenario}.support_lane"
+    warning, _, third = row.cells
+    if row.table == NON_TRANSIENT:
+        rules = (_FORWARD.impaired, _LANE.impaired)
+        return replace(row, rules=(*row.rules, *rules), cells=(warning, (forward, lane), third))
+    rules = (_FORWARD.off_road, _LANE.off_road)
+    return replace(row, rules=(*row.rules, *rules), cells=(warning, (forward,), (lane,)))
+
+
+ROWS: tuple[SheetRow, ...] = tuple(
+    _with_support(row) for row in (*_LONG_ROWS, *_SHORT_ROWS, *_PHONE_ROWS, *_NON_TRANSIENT_ROWS)
+)
 """Every row of the sheet that takes a prediction, in sheet order."""
 
 

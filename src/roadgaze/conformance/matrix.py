@@ -235,9 +235,10 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
     from roadgaze.conformance.drowsiness import drowsiness_scenarios
     from roadgaze.conformance.locations import location_scenarios
     from roadgaze.conformance.notices import notice_scenarios
+    from roadgaze.conformance.support import support_scenarios, with_support
     from roadgaze.conformance.timers import camera_scenarios, eye_scenarios, vats_scenarios
 
-    return [
+    scenarios = [
         *distraction_scenarios(config),
         *vats_scenarios(config),
         *eye_scenarios(config),
@@ -249,3 +250,6 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
         # The non-functional notices (Euro NCAP general requirements).
         *notice_scenarios(config),
     ]
+    # Forward and lane support: judged on the scenarios of roadgaze.conformance.support.SUPPORTED,
+    # and the long mirror looks of its own.
+    return [*with_support(config, scenarios), *support_scenarios(config)]

@@ -59,6 +59,12 @@ class Requirement:
     window_s: tuple[float, float] | None
     from_label: str = "look"
     applies: bool = True
+    held_until: str = ""
+    """For a support requirement (`kinds` are support outputs, `support_forward` ...): the
+    segment label until whose start the output must stay heightened once raised (`end`: to
+    the end of the drive); '' for an alert requirement. A support requirement measures the
+    first change to `heightened` at or after the start, and passes only when the output was
+    `normal` just before the start (roadgaze.conformance.support)."""
 
 
 @dataclass(frozen=True, slots=True)

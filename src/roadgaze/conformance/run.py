@@ -18,21 +18,26 @@ from roadgaze.capture import FrameSource
 from roadgaze.config import Config
 from roadgaze.conformance.clips import CLIP_SUFFIX, RenderedSource, ScenarioRenderer
 from roadgaze.conformance.model import Outcome, Scenario, judge
+from roadgaze.conformance.support import SUPPORT_OUTPUTS, SupportLog, judge_support
 from roadgaze.types import Alert, Frame, FrameRecord
 
 log = logging.getLogger(__name__)
 
 Alerts = list[tuple[str, str, float]]
-"""(kind, level, t_s) of every alert of a drive, in order."""
+"""(kind, level, t_s) of every alert of a drive, in order, with the changes of its support
+(output, level, t_s)."""
 
 
 class AlertLog:
-    """A sink keeping every alert of the drive."""
+    """A sink keeping every alert of the drive, and each change of its forward and lane support
+    (as (`support_forward`, level, t_s): roadgaze.conformance.support)."""
 
     def __init__(self) -> None:
         self.alerts: Alerts = []
+        self.support = SupportLog(self.alerts)  # one list, in the order they came
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
+        self.support.on_record(record)
         for alert in record.alerts:
             self.on_alert(alert)
 
@@ -63,11 +68,18 @@ def replay_drive(source: FrameSource, track: Path | None, config: Config) -> Ale
 
 def outcomes_of(scenario: Scenario, alerts: Alerts) -> list[Outcome]:
     """Each requirement of `scenario` judged on the drive's alerts."""
-    shown = tuple(f"{kind}:{level}@{t_s:.2f}" for kind, level, t_s in alerts)
+    shown = tuple(
+        f"{kind}:{level}@{t_s:.2f}" for kind, level, t_s in alerts if kind not in SUPPORT_OUTPUTS
+    )
     results = []
     for requirement in scenario.requirements:
         start_s = scenario.start_of(requirement.from_label)
-        measured, passed = judge(requirement, start_s, alerts)
+        if requirement.held_until:
+            until = requirement.held_until
+            until_s = scenario.duration_s if until == "end" else scenario.start_of(until)
+            measured, passed = judge_support(requirement, start_s, until_s, alerts)
+        else:
+            measured, passed = judge(requirement, start_s, alerts)
         results.append(Outcome(scenario.name, requirement, measured, passed, shown))
     return results
 

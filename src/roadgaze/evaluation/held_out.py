@@ -21,11 +21,14 @@ from __future__ import annotations
 import csv
 import tempfile
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from roadgaze.config import Config
+from roadgaze.config.support import SUPPORT_RAISE_MAX_S
 from roadgaze.errors import DatasetError
+from roadgaze.monitor.behaviours.support import HEIGHTENED, support_output
+from roadgaze.monitor.protocols.support import FORWARD
 from roadgaze.types import Alert, Frame, FrameRecord
 
 __all__ = [
@@ -47,6 +50,8 @@ WARN_MIN_S = 1.5
 WARN_MAX_S = 3.6
 """The window after the look's start in which a warning must come (the issue's Done when)."""
 DISTRACTION_KINDS = ("long_distraction",)
+SUPPORT_MAX_S = SUPPORT_RAISE_MAX_S
+"""Forward support must be heightened within this long of the look's start."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -129,6 +134,7 @@ class _Collect:
     alerts: list[tuple[float, str, str]] = field(default_factory=list)
     zones: list[str | None] = field(default_factory=list)
     yaws: list[float | None] = field(default_factory=list)
+    support: list[str | None] = field(default_factory=list)
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
         del frame
@@ -136,6 +142,8 @@ class _Collect:
             self.on_alert(alert)
         self.zones.append(record.verdict.zone if record.verdict is not None else None)
         self.yaws.append(record.sample.yaw_deg)
+        forward = support_output(record.verdict, FORWARD)
+        self.support.append(None if forward is None else forward.value)
 
     def on_alert(self, alert: Alert) -> None:
         self.alerts.append((alert.t_s, alert.kind.value, alert.reason))
@@ -156,6 +164,11 @@ class CaseResult:
     look_zones: tuple[str | None, ...]
     look_yaw_deg: float | None
     """The median smoothed yaw in the look's second half (None: no face)."""
+    support_s: float | None = None
+    """When forward support turned heightened, from the look's start (s; None: it did not)."""
+    support_before: str | None = None
+    """Forward support on the frame before the look (`normal` when the driver was seen
+    watching the road long enough)."""
 
     @property
     def warn_s(self) -> float | None:
@@ -180,6 +193,18 @@ class CaseResult:
     def passed(self) -> bool:
         return not self.why_failed
 
+    @property
+    def support_failed(self) -> str:
+        """'' when forward support was normal before the look and heightened within
+        `SUPPORT_MAX_S` of its start, else what went wrong (every look leaves the road)."""
+        if self.support_before != "normal":
+            return f"support {self.support_before} before the look"
+        if self.support_s is None:
+            return "support not raised"
+        if self.support_s > SUPPORT_MAX_S + 1e-6:
+            return f"support raised at {self.support_s:.2f} s"
+        return ""
+
 
 def run_case(
     stills: Stills,
@@ -198,7 +223,8 @@ def run_case(
         options = RunOptions(str(clip), command="held-out", speed_kmh=case.speed_kmh, quiet=True)
         with build_run(config, options, sinks=(collect,)) as run:
             run.run()
-    return result_of(stills, case, look_t_s, collect.alerts, collect.zones, collect.yaws)
+    result = result_of(stills, case, look_t_s, collect.alerts, collect.zones, collect.yaws)
+    return with_support(result, look_t_s, collect.support)
 
 
 def result_of(
@@ -221,3 +247,12 @@ def result_of(
         look_zones=tuple(zones[first:last]),
         look_yaw_deg=sorted(half)[len(half) // 2] if half else None,
     )
+
+
+def with_support(result: CaseResult, look_t_s: float, support: Sequence[str | None]) -> CaseResult:
+    """`result` with the forward support per frame (`support`) measured against the look."""
+    first = round(look_t_s * CLIP_FPS)
+    before = support[first - 1] if 0 < first <= len(support) else None
+    raised = next((i for i in range(first, len(support)) if support[i] == HEIGHTENED), None)
+    support_s = None if raised is None else (raised - first) / CLIP_FPS
+    return replace(result, support_s=support_s, support_before=before)

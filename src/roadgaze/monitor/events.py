@@ -20,16 +20,17 @@ __all__ = ["Event", "Publish", "Raise", "Resolve", "Rule", "Trigger", "published
 class Rule:
     """One requirement: `key` names it on the bus (e.g. `addw.distraction.above_50kmh`; its first
     part is the protocol), `config_key` is the `[monitor]` field that holds its value, in `unit`;
-    `source` says where it comes from and `what` what it asks for."""
+    `source` says where it comes from and `what` what it asks for. `impairment`: an alert by
+    this rule says the driver is impaired (drowsy, asleep: a non-transient state), so forward
+    and lane support stay heightened to the end of the trip
+    (roadgaze.monitor.behaviours.support)."""
 
     key: str
     config_key: str
     unit: str
     source: str
     what: str
-    until_trip_end: bool = False
-    """What this rule raises is not transient (Euro NCAP: drowsiness): a support it asks for
-    is held to the end of the trip, not cleared by looking at the road."""
+    impairment: bool = False
 
     @property
     def protocol(self) -> str:

@@ -20,6 +20,8 @@ from pathlib import Path
 from typing import IO, Any
 
 from roadgaze.errors import RoadgazeError
+from roadgaze.monitor.behaviours.support import output_name, support_output
+from roadgaze.monitor.protocols.support import CHANNELS
 from roadgaze.types import (
     Alert,
     ClosesOnExit,
@@ -30,6 +32,7 @@ from roadgaze.types import (
     HandSide,
     PhoneJudgement,
     Sink,
+    Verdict,
 )
 
 
@@ -101,6 +104,8 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("degraded", FieldType.BOOL),
     ("eye_calibration", FieldType.STR),
     ("alerts", FieldType.STR_LIST),
+    ("support_forward", FieldType.STR),
+    ("support_lane", FieldType.STR),
     *HAND_SCHEMA,
     ("yaw_offline_deg", FieldType.FLOAT),
     ("pitch_offline_deg", FieldType.FLOAT),
@@ -108,7 +113,8 @@ RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
 """Every field of `record_fields`, in order, with its type: the one description the writers and
 the fleet's Parquet schema are derived from (x_* in pixels of the roll-removed frame;
 `driver_ambiguous` why the driver cannot be told from another face in view, '' when it can; the eye
-fields as `roadgaze.types.EyesVerdict` defines them, `eyes` is open, closed or unavailable). A
+fields as `roadgaze.types.EyesVerdict` defines them, `eyes` is open, closed or unavailable;
+`support_forward` / `support_lane` `normal` or `heightened`, docs/monitor.md). A
 field added to `record_fields` is added here too (a test checks it)."""
 
 RECORD_FIELDS = tuple(name for name, _ in RECORD_SCHEMA)
@@ -177,6 +183,7 @@ def record_fields(record: FrameRecord) -> dict[str, Any]:
         "distraction_s": round(float(verdict.distraction_s), 3),
         **eye_fields(verdict.eyes),
         "alerts": [alert.label for alert in record.alerts],
+        **support_fields(verdict),
         **hand_fields(sample.hands, sample.phone),
         "yaw_offline_deg": None,
         "pitch_offline_deg": None,
@@ -210,6 +217,16 @@ def alert_fields(alert: Alert) -> dict[str, Any]:
         "rule": alert.rule,
         "source": alert.source,
     }
+
+
+def support_fields(verdict: Verdict) -> dict[str, Any]:
+    """Forward and lane support (`normal` or `heightened`; null when the support behaviour did
+    not run): roadgaze.monitor.behaviours.support."""
+    fields: dict[str, Any] = {}
+    for channel in CHANNELS:
+        output = support_output(verdict, channel)
+        fields[output_name(channel)] = None if output is None else output.value
+    return fields
 
 
 def hand_fields(hands: tuple[Hand, ...] | None, phone: PhoneJudgement | None) -> dict[str, Any]:

@@ -47,6 +47,7 @@ if TYPE_CHECKING:
     )
     from roadgaze.transport.speed import SPEED_MAX_KMH, SpeedInput, parse_speed_kmh
     from roadgaze.transport.subscription import Subscription
+    from roadgaze.transport.support_message import SUPPORT_SCHEMA, SupportLevel, SupportMessage
     from roadgaze.transport.throttle import ThrottledWarning
     from roadgaze.transport.vss import (
         VSS_PATHS,
@@ -97,6 +98,9 @@ _MODULE_OF = {
     "open_session": "roadgaze.transport.session",
     "parse_json_object": "roadgaze.transport.payloads",
     "parse_json_value": "roadgaze.transport.payloads",
+    "SUPPORT_SCHEMA": "roadgaze.transport.support_message",
+    "SupportLevel": "roadgaze.transport.support_message",
+    "SupportMessage": "roadgaze.transport.support_message",
     "parse_speed_kmh": "roadgaze.transport.speed",
     "parse_vss_text": "roadgaze.transport.vss",
     "plan_session": "roadgaze.transport.session",
@@ -127,6 +131,7 @@ __all__ = [
     "SPEED_MAX_BYTES",
     "SPEED_MAX_KMH",
     "STATE_SCHEMA",
+    "SUPPORT_SCHEMA",
     "VSS_PATHS",
     "YAW_SCHEMA",
     "AlertCounts",
@@ -145,6 +150,8 @@ __all__ = [
     "SpeedInput",
     "StateMessage",
     "Subscription",
+    "SupportLevel",
+    "SupportMessage",
     "ThrottledWarning",
     "TransportStatus",
     "VssLink",

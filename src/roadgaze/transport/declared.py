@@ -90,6 +90,14 @@ class Declared:
                 priority=zenoh.Priority.DATA,
             )
             self._entities.append(self.yaw)
+            self.support = session.declare_publisher(
+                keys.support,
+                encoding=zenoh.Encoding.APPLICATION_JSON,
+                congestion_control=zenoh.CongestionControl.DROP,
+                priority=zenoh.Priority.REAL_TIME,
+                express=True,
+            )
+            self._entities.append(self.support)
             if link.speed is not None and keys.speed is not None:
                 speed_subscriber = session.declare_subscriber(
                     keys.speed, zenoh.handlers.RingChannel(1)

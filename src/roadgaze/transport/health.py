@@ -18,6 +18,7 @@ from roadgaze.capture import FrameSource
 from roadgaze.config import Config
 from roadgaze.monitor import initial_state, verdict_of
 from roadgaze.monitor.behaviours.non_functional import notice_in
+from roadgaze.monitor.protocols.support import FORWARD, LANE
 from roadgaze.mounting import CameraMounting
 from roadgaze.transport.keys import Keys
 from roadgaze.transport.messages import (
@@ -28,6 +29,7 @@ from roadgaze.transport.messages import (
     TransportStatus,
 )
 from roadgaze.transport.publisher import MessageLink
+from roadgaze.transport.support_message import SupportLevel
 from roadgaze.types import Alert, Frame, FrameRecord
 
 ALERT_LOG = "roadgaze.daemon"
@@ -195,6 +197,8 @@ class Health:
                 phone_detection=phone is not None,
                 phone_use=None if phone is None else phone.phone_use,
                 non_functional=notice_in(verdict.outputs),
+                support_forward=SupportLevel.of(verdict, FORWARD),
+                support_lane=SupportLevel.of(verdict, LANE),
             ),
             config={
                 "monitor": monitor.model_dump(mode="json"),

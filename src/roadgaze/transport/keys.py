@@ -22,6 +22,8 @@ class Keys:
     alive: str
     state: str
     speed: str | None
+    support: str = ""
+    """Forward and lane support, one message per frame."""
 
     @classmethod
     def from_config(cls, config: ZenohConfig, vehicle_id: str | None = None) -> Keys:
@@ -55,6 +57,7 @@ class Keys:
             alive=f"{prefix}/alive",
             state=f"{prefix}/state",
             speed=speed,
+            support=f"{prefix}/support",
         )
 
     @property

@@ -10,6 +10,9 @@ Under the prefix (default `vehicle/{vehicle_id}/dms`):
   is back, and the last ones when it joins late. Plain subscribers get what is published while
   they are connected.
 - `yaw`: one `YawMessage` per frame, congestion control DROP, priority DATA (droppable).
+- `support`: one `SupportMessage` per frame (forward and lane support), congestion control DROP
+  (the next frame says it again: never stalls the loop), priority REAL_TIME, express; a
+  consumer that hears none for longer than it can wait takes support as heightened.
 - `alive`: a liveliness token, present while the daemon runs.
 - `state`: a queryable answering a `StateMessage` from a bounded thread (`StateResponder`).
 - with `vss_keys`, one text publisher per COVESA VSS signal (`roadgaze.transport.vss`):
@@ -47,6 +50,7 @@ from roadgaze.transport.session import (
     zenoh_error_text,
 )
 from roadgaze.transport.speed import SpeedInput
+from roadgaze.transport.support_message import SupportMessage
 from roadgaze.transport.vss import VSS_ATTACHMENT
 
 log = logging.getLogger(__name__)
@@ -85,6 +89,8 @@ class ZenohLink:
         self.session_reopens = 0
         self.yaw_sent = 0
         self.yaw_not_sent = 0
+        self.support_sent = 0
+        self.support_not_sent = 0
         self.vss_sent = 0
         self.vss_not_sent = 0
         self.last_error: str | None = None
@@ -161,16 +167,31 @@ class ZenohLink:
         query.reply(self.keys.state, data, encoding=zenoh.Encoding.APPLICATION_JSON)
 
     def publish_yaw(self, message: YawMessage) -> None:
+        if self._put_frame("yaw", message.to_json_bytes()):
+            self.yaw_sent += 1
+        else:
+            self.yaw_not_sent += 1  # droppable by design: the next frame says it again
+
+    def publish_support(self, message: SupportMessage) -> None:
+        """One frame's support; counted as not sent without a link (the next frame says it
+        again, and a consumer hearing nothing takes support as heightened)."""
+        if self._put_frame("support", message.to_json_bytes()):
+            self.support_sent += 1
+        else:
+            self.support_not_sent += 1
+
+    def _put_frame(self, name: str, payload: bytes) -> bool:
+        """Put one frame's message on the publisher `name` (`yaw`, `support`); False when no
+        link is up (nobody could receive it) or the put failed."""
         declared = self._declared
         if declared is None or not self.link_state.up:
-            self.yaw_not_sent += 1  # droppable by design: nobody could receive it
-            return
+            return False
         try:
-            declared.yaw.put(message.to_json_bytes())
-            self.yaw_sent += 1
+            getattr(declared, name).put(payload)
         except Exception as exc:
-            self.yaw_not_sent += 1
-            self.last_error = f"yaw put failed: {exc}"
+            self.last_error = f"{name} put failed: {exc}"
+            return False
+        return True
 
     def publish_vss(self, key: str, payload: bytes) -> None:
         """One VSS value (text) on its key, with Kuksa's `currentValue` attachment; counted as
@@ -289,9 +310,14 @@ class ZenohLink:
             routers=routers,
             session_reopens=self.session_reopens,
             yaw_sent=self.yaw_sent,
+            support_sent=self.support_sent,
             vss_sent=self.vss_sent,
             alerts_sent=counts.sent,
-            not_sent=self.yaw_not_sent + self.vss_not_sent + counts.failed + self._pending_dropped,
+            not_sent=self.yaw_not_sent
+            + self.support_not_sent
+            + self.vss_not_sent
+            + counts.failed
+            + self._pending_dropped,
             pending_alerts=pending,
             speed_messages=speed.messages if speed is not None else 0,
             speed_rejected=speed.rejected if speed is not None else 0,

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
+from roadgaze.transport.message_base import Message as _Message
+from roadgaze.transport.support_message import SupportLevel, SupportMessage
 from roadgaze.types import (
     Alert,
     AlertKind,
@@ -26,19 +28,6 @@ from roadgaze.types import (
 YAW_SCHEMA = "roadgaze.yaw/3"
 ALERT_SCHEMA = "roadgaze.alert/4"
 STATE_SCHEMA = "roadgaze.state/6"
-
-
-class _Message(BaseModel):
-    model_config = ConfigDict(
-        frozen=True,
-        populate_by_name=True,
-        extra="forbid",
-        json_schema_serialization_defaults_required=True,  # every field is always published
-        allow_inf_nan=False,  # JSON has no NaN or Infinity; a message holding one is refused
-    )
-
-    def to_json_bytes(self) -> bytes:
-        return self.model_dump_json(by_alias=True).encode("utf-8")
 
 
 class EyeFields(_Message):
@@ -240,10 +229,12 @@ class TransportStatus(_Message):
     routers: int = 0
     session_reopens: int = 0
     yaw_sent: int = 0
+    support_sent: int = Field(default=0, description="roadgaze.state/6: support messages sent.")
     vss_sent: int = Field(default=0, description="COVESA VSS values published.")
     alerts_sent: int = Field(default=0, description="Alerts published while the link was up.")
     not_sent: int = Field(
-        default=0, description="yaw_not_sent + VSS values not sent + alerts_failed."
+        default=0,
+        description="yaw_not_sent + support and VSS values not sent + alerts_failed.",
     )
     pending_alerts: int = Field(
         default=0, description="Client mode: alerts held by roadgaze until the session opens."
@@ -340,6 +331,13 @@ class MonitorSnapshot(EyeFields):
         "its reason, e.g. 'eyes_hidden: eyes hidden facing the road (eyes hidden) 5.0 s'; "
         "shown in every state message while it lasts (docs/monitor.md).",
     )
+    support_forward: SupportLevel = Field(
+        default_factory=SupportLevel,
+        description="roadgaze.state/6: forward support at the last frame (the support message).",
+    )
+    support_lane: SupportLevel = Field(
+        default_factory=SupportLevel, description="roadgaze.state/6: lane support, likewise."
+    )
 
 
 class StateMessage(_Message):
@@ -354,9 +352,10 @@ class StateMessage(_Message):
     failure in force, and the eye calibration (`eye_calibration`); `permanent_failure` (the
     camera gone past `permanent_failure_s`); and `alerts_waiting`, `alerts_lost` and
     `undelivered_alerts` to `transport` (the alert ledger). `roadgaze.state/5` adds
-    `driver_ambiguous`; `roadgaze.state/6` adds `phone_detection`, `phone_use` and
-    `non_functional` to `monitor` (the non-functional notice in force, shown for as long as it
-    lasts). The monitor's angles are in the driver's frame (the camera mounting applied).
+    `driver_ambiguous`; `roadgaze.state/6` adds `phone_detection`, `phone_use`,
+    `non_functional` (the notice in force, for as long as it lasts), `support_forward` and
+    `support_lane` (the support message's levels) to `monitor` and `support_sent` to
+    `transport`. The monitor's angles are in the driver's frame (the camera mounting applied).
     Every earlier field keeps its name and meaning.
     """
 
@@ -389,6 +388,7 @@ MESSAGE_MODELS: dict[str, type[_Message]] = {
     "yaw": YawMessage,
     "alert": AlertMessage,
     "state": StateMessage,
+    "support": SupportMessage,
 }
 
 

@@ -9,6 +9,7 @@ from typing import Protocol
 
 from roadgaze.transport.messages import AlertMessage, TransportStatus, YawMessage
 from roadgaze.transport.speed import SpeedInput
+from roadgaze.transport.support_message import SupportMessage
 from roadgaze.types import Alert, Frame, FrameRecord
 
 
@@ -21,11 +22,14 @@ class MessageLink(Protocol):
 
     def publish_alert(self, message: AlertMessage) -> None: ...
 
+    def publish_support(self, message: SupportMessage) -> None: ...
+
     def status(self) -> TransportStatus: ...
 
 
 class BusPublisher:
-    """Pipeline sink: publishes one `YawMessage` per record and one `AlertMessage` per alert.
+    """Pipeline sink: publishes one `YawMessage` and one `SupportMessage` per record and one
+    `AlertMessage` per alert.
 
     Sequence numbers count per key from 0; `wall_time` is stamped when the message is built.
     """
@@ -41,6 +45,7 @@ class BusPublisher:
         self._wall_clock = wall_clock
         self._yaw_seq = 0
         self._alert_seq = 0
+        self._support_seq = 0
         self._lock = threading.Lock()
 
     def on_record(self, record: FrameRecord, frame: Frame) -> None:
@@ -49,6 +54,10 @@ class BusPublisher:
             YawMessage.from_record(record, self.vehicle_id, self._yaw_seq, wall_time)
         )
         self._yaw_seq += 1
+        self.link.publish_support(
+            SupportMessage.from_record(record, self.vehicle_id, self._support_seq, wall_time)
+        )
+        self._support_seq += 1
         for alert in record.alerts:
             self.publish_alert(alert, wall_time)
 

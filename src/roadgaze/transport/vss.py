@@ -29,6 +29,9 @@ Values (definitions and how the levels are computed: docs/zenoh.md):
   unavailable too long) or a temporary failure in force (blocked, black, saturated or frozen
   frames, no judgeable face; docs/monitor.md, "Failures"); a permanent failure (camera gone)
   sends `IsError` and `IsWarning` true when raised, false when cleared (`publish_failure`).
+- `ADAS.DMS.Support.Forward.IsHeightened`, `ADAS.DMS.Support.Lane.IsHeightened`: forward and
+  lane support (the support message). VSS 6.0 has no standard path for them: they are
+  roadgaze's overlay branch (docs/vss/roadgaze-support.vspec); true when unknown (fail-safe).
 """
 
 from __future__ import annotations
@@ -38,10 +41,13 @@ import re
 from typing import Protocol
 
 from roadgaze.config import MonitorConfig
+from roadgaze.monitor.behaviours.support import HEIGHTENED, support_output
+from roadgaze.monitor.protocols.support import FORWARD, LANE
 from roadgaze.transport.payloads import PayloadError, printable
 from roadgaze.types import Alert, AlertKind, EyeStatus, Frame, FrameRecord, Gaze
 
 __all__ = [
+    "SUPPORT_PATHS",
     "VSS_ATTACHMENT",
     "VSS_MAX_RATE_HZ",
     "VSS_PATHS",
@@ -62,6 +68,9 @@ DRIVER = "Vehicle.Driver"
 HEAD = "Vehicle.Occupant.Row1.DriverSide.HeadPosition"
 GAZE = "Vehicle.Occupant.Row1.DriverSide.MidEyeGaze"
 DMS = "Vehicle.ADAS.DMS"
+SUPPORT = f"{DMS}.Support"
+"""roadgaze's overlay branch (not in VSS 6.0): forward and lane support."""
+SUPPORT_PATHS = {FORWARD: f"{SUPPORT}.Forward.IsHeightened", LANE: f"{SUPPORT}.Lane.IsHeightened"}
 VSS_PATHS: tuple[str, ...] = (
     f"{DRIVER}.IsEyesOnRoad",
     f"{DRIVER}.DistractionLevel",
@@ -74,6 +83,7 @@ VSS_PATHS: tuple[str, ...] = (
     f"{GAZE}.Elevation",
     f"{DMS}.IsWarning",
     f"{DMS}.IsError",
+    *SUPPORT_PATHS.values(),
 )
 
 VssValue = bool | float
@@ -92,6 +102,7 @@ VSS_RANGES: dict[str, tuple[float, float] | None] = {
     f"{GAZE}.Elevation": (-90.0, 90.0),
     f"{DMS}.IsWarning": None,
     f"{DMS}.IsError": None,
+    **dict.fromkeys(SUPPORT_PATHS.values()),
 }
 """The type of each signal roadgaze publishes: None for a boolean, else the allowed range."""
 VSS_MAX_CHARS = 64
@@ -191,6 +202,9 @@ def vss_values(record: FrameRecord, config: MonitorConfig) -> dict[str, VssValue
         f"{DMS}.IsWarning": bool(verdict.active),
         f"{DMS}.IsError": eyes.degraded or bool(verdict.failure),
     }
+    for channel, path in SUPPORT_PATHS.items():
+        output = support_output(verdict, channel)
+        values[path] = output is None or output.value == HEIGHTENED
     angles = {
         f"{HEAD}.Yaw": _relative(verdict.yaw_deg, verdict.neutral_yaw_deg),
         f"{HEAD}.Pitch": _relative(verdict.pitch_deg, verdict.neutral_pitch_deg, pitch=True),

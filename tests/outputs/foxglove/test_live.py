@@ -86,6 +86,7 @@ def test_a_client_is_told_every_channel_subscribes_and_receives_records_and_imag
             "/roadgaze/limits": "roadgaze.limits",
             "/roadgaze/alerts": "roadgaze.alert/4",
             "/roadgaze/state": "roadgaze.state/6",
+            "/roadgaze/support": "roadgaze.support/1",
             "/roadgaze/log": "foxglove.Log",
             "/roadgaze/driver": "roadgaze.driver/1",
         }

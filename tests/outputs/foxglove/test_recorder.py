@@ -30,6 +30,7 @@ from roadgaze.outputs.foxglove.channels import (
     TOPIC_LOG,
     TOPIC_RECORD,
     TOPIC_STATE,
+    TOPIC_SUPPORT,
     TOPICS,
 )
 from roadgaze.outputs.foxglove.open import replay_recorder, vehicle_recorder
@@ -78,6 +79,7 @@ def test_each_channel_has_its_well_known_or_own_schema(
         TOPIC_LIMITS: "roadgaze.limits",
         TOPIC_ALERTS: "roadgaze.alert/4",
         TOPIC_STATE: "roadgaze.state/6",
+        TOPIC_SUPPORT: "roadgaze.support/1",
         TOPIC_DRIVER: "roadgaze.driver/1",
     }
     assert contents.encodings[TOPIC_IMAGE] == ("protobuf", "protobuf")
@@ -86,6 +88,12 @@ def test_each_channel_has_its_well_known_or_own_schema(
 
     alert_schema = json.loads(contents.schema_data[TOPIC_ALERTS])
     assert alert_schema == json_schemas()["alert"]  # what `roadgaze schema alert` prints
+    support_schema = json.loads(contents.schema_data[TOPIC_SUPPORT])
+    assert support_schema == json_schemas()["support"]
+    supports, records = contents.json(TOPIC_SUPPORT), contents.json(TOPIC_RECORD)
+    assert supports and len(supports) == len(records)  # one per frame
+    assert [m["seq"] for m in supports] == list(range(len(supports)))
+    assert [m["forward"]["level"] for m in supports] == [r["support_forward"] for r in records]
 
 
 def test_one_record_per_frame_equal_to_the_jsonl_record(

@@ -7,6 +7,7 @@ from roadgaze.monitor.behaviours.drowsy import Drowsy, DrowsyState
 from roadgaze.monitor.behaviours.eye_closure import CLOSURE_ALERTS, EyeClosure, EyeClosureState
 from roadgaze.monitor.behaviours.non_functional import NonFunctional, NonFunctionalState
 from roadgaze.monitor.behaviours.phone_use import PhoneUse, PhoneUseState
+from roadgaze.monitor.behaviours.support import Support, SupportState
 from roadgaze.monitor.behaviours.temporary_failure import FailureState, TemporaryFailure
 from roadgaze.monitor.behaviours.unavailable import Unavailable, UnavailableState
 from roadgaze.monitor.behaviours.unresponsive import Unresponsive, UnresponsiveState
@@ -29,6 +30,8 @@ __all__ = [
     "NonFunctionalState",
     "PhoneUse",
     "PhoneUseState",
+    "Support",
+    "SupportState",
     "TemporaryFailure",
     "Unavailable",
     "UnavailableState",

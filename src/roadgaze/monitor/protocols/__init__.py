@@ -23,6 +23,7 @@ from roadgaze.monitor.behaviours import (
     EyeClosure,
     NonFunctional,
     PhoneUse,
+    Support,
     TemporaryFailure,
     Unavailable,
     Unresponsive,
@@ -30,7 +31,7 @@ from roadgaze.monitor.behaviours import (
 )
 from roadgaze.monitor.context import Behaviour
 from roadgaze.monitor.events import Rule, Trigger
-from roadgaze.monitor.protocols import addw, euroncap, roadgaze
+from roadgaze.monitor.protocols import addw, euroncap, roadgaze, support
 
 __all__ = [
     "ALL_RULES",
@@ -44,10 +45,11 @@ __all__ = [
     "euroncap",
     "moving_at",
     "roadgaze",
+    "support",
     "uses",
 ]
 
-ALL_RULES: tuple[Rule, ...] = (*addw.RULES, *euroncap.RULES, *roadgaze.RULES)
+ALL_RULES: tuple[Rule, ...] = (*addw.RULES, *euroncap.RULES, *roadgaze.RULES, *support.RULES)
 """Every rule, for the documentation's table and conformance reports."""
 
 TABLE: tuple[tuple[str, Behaviour[Any]], ...] = (
@@ -77,6 +79,9 @@ TABLE: tuple[tuple[str, Behaviour[Any]], ...] = (
             eyes_needed_by="euroncap",
         ),
     ),
+    # Forward and lane support: after every behaviour that raises alerts (it reads their
+    # impairment alerts), before clearing.
+    *(("roadgaze", Support(c, support.support_rules(c))) for c in support.CHANNELS),
     ("roadgaze", Clearing(roadgaze.CLEAR)),
 )
 """Which behaviour runs for which protocol, configured with which rules, in the order they run

@@ -93,9 +93,15 @@ MICROSLEEP = Rule(
     "s",
     f"{_DSM}: microsleep, a closure shorter than 3 s (roadgaze warns from 1 s)",
     "eyes closed this long",
+    impairment=True,
 )
 SLEEP = Rule(
-    "euroncap.sleep", "sleep_s", "s", f"{_DSM}: sleep, a closure longer than 3 s", "closed"
+    "euroncap.sleep",
+    "sleep_s",
+    "s",
+    f"{_DSM}: sleep, a closure longer than 3 s",
+    "closed",
+    impairment=True,
 )
 IMPAIRED = Rule(
     "euroncap.impaired_monitoring",
@@ -113,7 +119,7 @@ DROWSINESS = Rule(
     f"{_SD_2026}: drowsiness at a level equivalent to KSS 7 or more (smarteye.se's summary of "
     "the 2026 protocol); the level is roadgaze's KSS-like scale of sourced signs",
     "warn at this drowsiness level or above",
-    until_trip_end=True,
+    impairment=True,
 )
 DROWSINESS_SPEED = Rule(
     "euroncap.drowsiness.min_speed",

@@ -42,6 +42,7 @@ DROWSY = Rule(
     "fraction",
     "PERCLOS P80 (Wierwille et al. 1994; Dinges et al. 1998); the level is roadgaze's choice",
     "PERCLOS at or above this",
+    impairment=True,
 )
 FROZEN = Rule(
     "roadgaze.failure.frozen",

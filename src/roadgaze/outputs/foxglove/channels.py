@@ -7,10 +7,10 @@ are drawn on) and the logs (`foxglove.Log`). JSON Schema channels for roadgaze's
 frame record (`record_fields`, every frame; its schema derived from `RECORD_SCHEMA`, so a new
 field flows in without a change here), the monitor's limits (the road zone around the learned
 neutral, the timers' thresholds; when the neutral moves, and at least every state interval),
-the alerts and the state (the messages `roadgaze schema` prints, named by their version, so a
-new alert kind or field flows in too), and the driver chosen on each recorded camera frame
-(`/roadgaze/driver`, `roadgaze.capture.mcap_driver`: a replay of the recording follows it). Every
-message is stamped with its frame's capture time
+the alerts, the state and forward and lane support (every frame; the messages `roadgaze
+schema` prints, named by their version, so a new alert kind or field flows in too), and the
+driver chosen on each recorded camera frame (`/roadgaze/driver`, `roadgaze.capture.mcap_driver`:
+a replay of the recording follows it). Every message is stamped with its frame's capture time
 (`log_time` = `publish_time`, and the header stamps).
 """
 
@@ -49,7 +49,9 @@ from roadgaze.errors import RoadgazeError
 from roadgaze.outputs.annotate import face_lines_px, verdict_text
 from roadgaze.outputs.plots import road_bands_deg, road_pitch_bands_deg, timer_thresholds
 from roadgaze.outputs.records import RECORD_SCHEMA, FieldType, record_fields, rounded
+from roadgaze.transport.message_base import Message
 from roadgaze.transport.messages import AlertMessage, StateMessage
+from roadgaze.transport.support_message import SupportMessage
 from roadgaze.types import Alert, FrameRecord
 
 TOPIC_IMAGE = "/camera/image"
@@ -58,6 +60,7 @@ TOPIC_RECORD = "/roadgaze/record"
 TOPIC_LIMITS = "/roadgaze/limits"
 TOPIC_ALERTS = "/roadgaze/alerts"
 TOPIC_STATE = "/roadgaze/state"
+TOPIC_SUPPORT = "/roadgaze/support"
 TOPIC_LOG = "/roadgaze/log"
 TOPIC_DRIVER = DRIVER_TOPIC
 TOPICS = (
@@ -68,6 +71,7 @@ TOPICS = (
     TOPIC_LIMITS,
     TOPIC_ALERTS,
     TOPIC_STATE,
+    TOPIC_SUPPORT,
     TOPIC_LOG,
 )
 CAMERA_FRAME_ID = "driver_camera"
@@ -144,7 +148,7 @@ def _json_schema(name: str, schema: dict[str, Any]) -> foxglove.Schema:
     return foxglove.Schema(name=name, encoding="jsonschema", data=json.dumps(schema).encode())
 
 
-def _model_schema(model: type[AlertMessage] | type[StateMessage]) -> foxglove.Schema:
+def _model_schema(model: type[Message]) -> foxglove.Schema:
     """A message model's JSON Schema (as `roadgaze schema` prints it), named by its version."""
     name = str(model.model_fields["schema_id"].default)
     return _json_schema(name, model.model_json_schema(by_alias=True, mode="serialization"))
@@ -272,6 +276,12 @@ class FrameChannels:
             message_encoding="json",
             context=context,
         )
+        self.support = foxglove.Channel(
+            TOPIC_SUPPORT,
+            schema=_model_schema(SupportMessage),
+            message_encoding="json",
+            context=context,
+        )
         self.log = LogChannel(TOPIC_LOG, context=context)
         self.driver = foxglove.Channel(
             TOPIC_DRIVER,
@@ -280,6 +290,7 @@ class FrameChannels:
             context=context,
         )
         self.alerts_logged = 0
+        self.support_logged = 0
 
     def log_frame(
         self,
@@ -294,6 +305,11 @@ class FrameChannels:
         the annotations when `annotate` (the frame carries a camera image: they are drawn on
         it), and the alerts raised on this frame."""
         self.record.log(_json_bytes(record_fields(record)), log_time=stamp_ns)
+        support = SupportMessage.from_record(
+            record, self.vehicle_id, self.support_logged, wall_time_s
+        )
+        self.support.log(support.to_json_bytes(), log_time=stamp_ns)
+        self.support_logged += 1
         verdict = record.verdict
         neutral = (verdict.neutral_yaw_deg, verdict.neutral_pitch_deg)
         if neutral != self._limits_neutral or stamp_ns >= self._limits_due_ns:

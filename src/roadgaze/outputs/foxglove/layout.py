@@ -26,6 +26,7 @@ from roadgaze.outputs.foxglove.channels import (
     TOPIC_LOG,
     TOPIC_RECORD,
     TOPIC_STATE,
+    TOPIC_SUPPORT,
 )
 
 APP_PANEL_TYPES = {"Log": "RosOut"}
@@ -108,7 +109,15 @@ def panels() -> dict[str, fl.BasePanel]:
                 fl.StateTransitionsSeries(
                     value=f"{TOPIC_RECORD}.{field}", label=field, timestamp_method="receiveTime"
                 )
-                for field in ("zone", "gaze", "eyes", "eyes_on_road", "driver_ambiguous")
+                for field in (
+                    "zone",
+                    "gaze",
+                    "eyes",
+                    "eyes_on_road",
+                    "driver_ambiguous",
+                    "support_forward",
+                    "support_lane",
+                )
             ],
         ),
     )
@@ -118,6 +127,9 @@ def panels() -> dict[str, fl.BasePanel]:
     state = fl.RawMessagesPanel(title="state", config=fl.RawMessagesConfig(topic_path=TOPIC_STATE))
     driver = fl.RawMessagesPanel(
         title="driver", config=fl.RawMessagesConfig(topic_path=TOPIC_DRIVER)
+    )
+    support = fl.RawMessagesPanel(
+        title="support", config=fl.RawMessagesConfig(topic_path=TOPIC_SUPPORT)
     )
     log = fl.LogPanel(title="log", config=fl.LogConfig(topic_to_render=TOPIC_LOG))
     return {
@@ -129,6 +141,7 @@ def panels() -> dict[str, fl.BasePanel]:
         "alerts": alerts,
         "state": state,
         "driver": driver,
+        "support": support,
         "log": log,
     }
 
@@ -151,7 +164,8 @@ def layout() -> dict[str, Any]:
         config_by_id[key] = config
         keys[name] = key
     left = _split("column", keys["image"], keys["states"], 70)
-    state = _split("column", keys["state"], keys["driver"], 70)
+    driver = _split("column", keys["driver"], keys["support"], 50)
+    state = _split("column", keys["state"], driver, 70)
     bottom = _split("row", keys["alerts"], _split("row", state, keys["log"], 50), 34)
     right = _split(
         "column",

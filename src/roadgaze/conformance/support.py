@@ -1,0 +1,152 @@
+"""Forward and lane support in the conformance suite: the support a drive's frames carried, the
+requirements on it and how they are judged.
+
+The drive's sink logs each change of the support outputs (`support_forward`, `support_lane`:
+roadgaze.monitor.behaviours.support) beside the alerts, as (output, level, t_s). A support
+requirement is met when the output was `normal` just before its clock starts (so the raise is
+the glance's, not left over), turns `heightened` within `support_raise_max_s` of the start (the
+look's first frame: the head's turn is inside that time), and stays heightened until the
+segment it names starts (`end`: to the end of the drive, for an impairment).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from roadgaze.config import MonitorConfig
+from roadgaze.config.support import SUPPORT_RAISE_MAX_S
+from roadgaze.conformance.model import Requirement, Scenario, Segment
+from roadgaze.monitor.behaviours.support import HEIGHTENED, NORMAL, output_name
+from roadgaze.monitor.protocols.support import CHANNELS, support_rules
+from roadgaze.types import FrameRecord, Verdict
+
+__all__ = [
+    "SUPPORTED",
+    "SUPPORT_OUTPUTS",
+    "SupportLog",
+    "judge_support",
+    "support_requirements",
+    "support_scenarios",
+    "with_support",
+]
+
+SUPPORT_OUTPUTS = frozenset(output_name(channel) for channel in CHANNELS)
+"""The outputs logged beside the alerts."""
+
+SUPPORTED: dict[str, tuple[str, str]] = {
+    "lap_70": ("look", "back"),
+    "side_left_70": ("look", "back"),
+    "side_right_70": ("look", "back"),
+    "centre_stack_70": ("look", "back"),
+    "mirror_left_70": ("look", "back"),
+    "mirror_right_70": ("look", "back"),
+    "vats_70": ("look", "glance1"),
+    "microsleep_70": ("event", "end"),
+    "sleep_70": ("event", "end"),
+    # The gaze locations (roadgaze.conformance.locations): owl, lizard and body lean.
+    "owl_passenger_footwell_70": ("look", "back"),
+    "owl_passenger_face_70": ("look", "back"),
+    "lizard_infotainment_70": ("look", "back"),
+    "lizard_glovebox_70": ("look", "back"),
+    "lean_passenger_footwell_70": ("look", "back"),
+    "lean_rear_passenger_70": ("look", "back"),
+    "vats_owl_passenger_footwell_70": ("look", "glance1"),
+    "vats_lizard_infotainment_70": ("look", "glance1"),
+    "vats_lizard_passenger_footwell_70": ("look", "glance1"),
+    "vats_lizard_multi_target_70": ("look", "glance1"),
+}
+"""Scenarios of the matrix whose support is judged: (the label its clock starts at, the label
+until which support must hold; `end`: the end of the drive, after an impairment)."""
+
+
+class SupportLog:
+    """Each change of the frame records' support outputs, as (output, level, t_s)."""
+
+    def __init__(self, changes: list[tuple[str, str, float]] | None = None) -> None:
+        self.changes: list[tuple[str, str, float]] = [] if changes is None else changes
+        self._last: dict[str, str] = {}
+
+    def on_verdict(self, verdict: Verdict, t_s: float) -> None:
+        for output in verdict.outputs:
+            if output.name.startswith("support_") and self._last.get(output.name) != output.value:
+                self._last[output.name] = output.value
+                self.changes.append((output.name, output.value, t_s))
+
+    def on_record(self, record: FrameRecord) -> None:
+        self.on_verdict(record.verdict, record.t_s)
+
+
+def support_requirements(
+    config: MonitorConfig, scenario: str, from_label: str, held_until: str
+) -> tuple[Requirement, ...]:
+    """Forward and lane support raised within the bound of the labelled start, held until
+    `held_until`."""
+    requirements = []
+    for channel in CHANNELS:
+        rules = support_rules(channel)
+        rule = rules.impaired if held_until == "end" else rules.off_road
+        held = "to the end of the trip" if held_until == "end" else f"until {held_until}"
+        text = f"{channel} support heightened within {SUPPORT_RAISE_MAX_S:g} s, held {held}"
+        source = f"{rule.key}: {rule.source}"
+        window = (0.0, SUPPORT_RAISE_MAX_S)
+        requirements.append(
+            Requirement(
+                f"{scenario}.{output_name(channel)}",
+                text,
+                source,
+                (output_name(channel),),
+                window,
+                from_label,
+                held_until=held_until,
+            )
+        )
+    return tuple(requirements)
+
+
+def with_support(config: MonitorConfig, scenarios: list[Scenario]) -> list[Scenario]:
+    """`scenarios` with the support requirements of those in `SUPPORTED` added."""
+    added = []
+    for scenario in scenarios:
+        labels = SUPPORTED.get(scenario.name)
+        if labels is not None:
+            extra = support_requirements(config, scenario.name, *labels)
+            scenario = replace(scenario, requirements=(*scenario.requirements, *extra))
+        added.append(scenario)
+    return added
+
+
+def support_scenarios(config: MonitorConfig) -> list[Scenario]:
+    """A 4 s look at each side mirror at 70 km/h: a long driving-task glance, support only."""
+    from roadgaze.conformance.matrix import FAST_KMH, LOOK_S, ahead, back, look, zone_target
+
+    scenarios = []
+    for side in ("left", "right"):
+        name = f"mirror_{side}_4s_70"
+        text = f"{LOOK_S:g} s {side} mirror look at {FAST_KMH:g} km/h: forward and lane support"
+        target = zone_target(config, f"{side}_mirror")
+        segments: tuple[Segment, ...] = (ahead(), look(target, LOOK_S), back())
+        requirements = support_requirements(config, name, "look", "back")
+        scenarios.append(Scenario(name, text, segments, FAST_KMH, requirements))
+    return scenarios
+
+
+def judge_support(
+    requirement: Requirement,
+    start_s: float,
+    until_s: float,
+    changes: list[tuple[str, str, float]],
+) -> tuple[float | None, bool]:
+    """(measured, passed): when the output turned heightened after `start_s` (0 when it already
+    was: then it fails, the raise was not the scenario's), and whether it did so in the window
+    from normal and held until `until_s`."""
+    mine = [(level, t_s) for name, level, t_s in changes if name in requirement.kinds]
+    before = [level for level, t_s in mine if t_s < start_s - 1e-9]
+    was_normal = bool(before) and before[-1] == NORMAL
+    raised = [t_s for level, t_s in mine if level == HEIGHTENED and t_s >= start_s - 1e-9]
+    if not raised:
+        return (0.0 if not was_normal and before else None), False
+    measured = raised[0] - start_s
+    dropped = [t_s for level, t_s in mine if level == NORMAL and raised[0] < t_s < until_s - 1e-9]
+    window = requirement.window_s or (0.0, SUPPORT_RAISE_MAX_S)
+    in_window = window[0] - 1e-9 <= measured <= window[1] + 1e-9
+    return measured, was_normal and in_window and not dropped

@@ -17,7 +17,17 @@ from roadgaze.monitor.behaviours.support import support_output
 from roadgaze.monitor.context import Context
 from roadgaze.monitor.events import Event, Raise, Rule
 from roadgaze.monitor.protocols import behaviours
-from roadgaze.types import Alert, AlertKind, AlertLevel, EyesFeatures, Output, PoseSample
+from roadgaze.types import (
+    Alert,
+    AlertKind,
+    AlertLevel,
+    EyesFeatures,
+    HandSide,
+    Output,
+    PhoneJudgement,
+    PhonePose,
+    PoseSample,
+)
 
 FPS = 15.0
 CONFIG = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=0.0)
@@ -33,6 +43,7 @@ class Pose:
     face: bool = True
     ambiguous: str = ""
     speed_kmh: float | None = 70.0
+    phone: PhoneJudgement | None = None
 
 
 Script = Callable[[float], Pose]
@@ -66,6 +77,7 @@ def drive(
             pitch_deg=pose.pitch_deg if face else None,
             eyes=pose.eyes if face else None,
             driver_ambiguous=pose.ambiguous,
+            phone=pose.phone,
         )
         alerts.extend(monitor.update(sample, pose.speed_kmh))
         forward = support_output(monitor.verdict, "forward")
@@ -246,3 +258,25 @@ def test_each_channel_runs_before_clearing_with_documented_rules() -> None:
         for rule in behaviour.rules.all:
             assert rule in ALL_RULES and rule.source
             assert hasattr(CONFIG, rule.config_key)
+
+
+IN_HAND = PhoneJudgement(phone_use=True, score=0.9, hand=HandSide.RIGHT, pose=PhonePose.HELD_UP)
+NO_PHONE = PhoneJudgement(phone_use=False, score=0.1)
+
+
+def test_a_phone_held_up_on_the_road_raises_support_with_its_warning_not_per_frame() -> None:
+    # Eyes on the road throughout; the phone judged in hand from 3 s to 8 s: phone_use warns
+    # after phone_use_s (3 s), at 6 s, and support with it; put down at 8 s, the alert clears
+    # after phone_gap_s (0.7 s, at frame 130) and support after the clear time (2 s) on the road.
+    held = Pose(eyes=eyes_of(), phone=IN_HAND)
+    seen, alerts = drive(glance(3.0, 8.0, held, Pose(eyes=eyes_of(), phone=NO_PHONE)), 12.0,
+                         MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=0.0,
+                                       protocol="euroncap"))  # fmt: skip
+    assert [(round(a.t_s, 2), a.kind) for a in alerts] == [
+        (6.0, AlertKind.PHONE_USE),
+        (8.67, AlertKind.CLEARED),
+    ]
+    assert first(seen, "heightened", 3.0) == pytest.approx(6.0)  # not at the first frame in hand
+    assert at(seen, 6.0).reason == "phone in use"
+    # Watching the road counts from the frame after the alert cleared (frame 131).
+    assert first(seen, "normal", 6.0) == pytest.approx(131 / FPS + 2.0)

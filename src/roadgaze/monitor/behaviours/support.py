@@ -3,7 +3,8 @@
 One behaviour per channel (`support_forward`, `support_lane`), published at every sample with
 its rule, reason and since when (`Publish`). Heightened once the driver has not been watching
 the road for `support_raise_s` (0: at the first such sample): any zone but the road, driving-task
-glances (mirrors, cluster) included, or the eyes closed; and, fail-safe, whenever the service
+glances (mirrors, cluster) included, the eyes closed, or a phone in use (the `phone_use` alert in
+force); and, fail-safe, whenever the service
 cannot tell (no face, two faces, the eyes unavailable, no speed, a bad frame). Normal again once
 the driver has watched the road, everything known, for `support_clear_s`. An alert whose rule is
 an impairment (`Rule.impairment`: drowsy, microsleep, sleep) holds it heightened to the end of
@@ -18,7 +19,7 @@ from typing import TYPE_CHECKING
 from roadgaze.monitor.context import Context
 from roadgaze.monitor.episode import run_since
 from roadgaze.monitor.events import Event, Publish, Raise, Rule
-from roadgaze.types import EyeStatus, Gaze, Output, Verdict
+from roadgaze.types import AlertKind, EyeStatus, Gaze, Output, Verdict
 
 if TYPE_CHECKING:  # the protocols import the behaviours
     from roadgaze.monitor.protocols.support import SupportRules
@@ -66,7 +67,7 @@ class Support:
     def step(self, context: Context, state: SupportState) -> tuple[SupportState, tuple[Event, ...]]:
         config, t_s = context.config, context.t_s
         impaired = state.impaired or (_impairment(context) if config.support_hold_impaired else "")
-        away = "" if context.looking else _away(context)
+        away = ("" if context.looking else _away(context)) or _phone(context)
         unknown = _unknown(context) if context.looking or not away else ""
         watching = not (away or unknown)
         watching_since = run_since(watching, state.watching_since_s, t_s)
@@ -102,6 +103,16 @@ def _impairment(context: Context) -> str:
         if isinstance(event, Raise) and event.rule.impairment:
             return f"{event.kind.value} ({event.rule.key})"
     return ""
+
+
+def _phone(context: Context) -> str:
+    """A phone in use, by the `phone_use` alert in force or raised now ('' for none): the eyes of
+    a driver with a phone held up may stay near the road, the mind is not on it. The alert, not
+    the per-frame judgement, so a frame's false judgement does not raise support."""
+    raised = any(
+        isinstance(event, Raise) and event.kind is AlertKind.PHONE_USE for event in context.events
+    )
+    return "phone in use" if raised or AlertKind.PHONE_USE in context.active else ""
 
 
 def _unknown(context: Context) -> str:

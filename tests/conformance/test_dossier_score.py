@@ -37,10 +37,12 @@ def test_without_the_pinned_calculator_one_line_says_how_to_install_it(
 
 @pytest.mark.slow
 def test_the_calculator_pays_the_rows_whose_tests_pass_again(tmp_path: Path) -> None:
-    """Microsleep and sleep warnings (0.5 each) with their forward and lane support (1.5 each)
-    and the unresponsive driver's emergency function (2.0) are the GREEN rows whose whole group
-    is GREEN: 6 points with the gates taken as met; a sleep test failing when run again takes
-    its points."""
+    """Every scenario passing and the gates taken as met: the long and short distraction groups
+    whose every cell is GREEN (owl, lizard, body lean: warning, forward and lane support),
+    drowsiness' warning, microsleep and sleep (warning, forward and lane support) and the
+    unresponsive driver's emergency function: 12.5 points, each selected test answered PASS;
+    a sleep test failing when run again takes its points. The calculator draws the distraction
+    tests at random: only the fixed ones are named."""
     pytest.importorskip("euroncap_rating_2026", reason="needs roadgaze[euroncap]")
     assert require_calculator() == dossier_score.PINNED
     template = Calculator(tmp_path / "template").template()
@@ -49,26 +51,23 @@ def test_the_calculator_pays_the_rows_whose_tests_pass_again(tmp_path: Path) -> 
 
     runner = FakeRunner()
     passed = score(dossier, path, Calculator(tmp_path / "pass"), SCENARIOS, runner, True)
-    assert passed.score.points == 6.0 and passed.score.max_points == 25.0
-    answers = {(a.column, a.row, a.value) for a in passed.answers}
-    assert {("D", 70, "PASS"), ("D", 71, "PASS"), ("F", 72, "PASS")} < answers
-    # one of the GREEN microsleep/sleep supports, drawn at random
-    assert len(answers - {("D", 70, "PASS"), ("D", 71, "PASS"), ("F", 72, "PASS")}) == 1
-    assert answers & {("E", 70, "PASS"), ("E", 71, "PASS")}
-    assert (
-        set(runner.calls)
-        == {
-            "microsleep_70",
-            "sleep_70",
-            "unresponsive_closed_70",
-            "unresponsive_away_70",
-        }
-        <= set(runner.calls)
-    )
     categories = {name: got for name, got, _ in passed.score.categories}
-    assert categories["Non-transient - Unresponsive"] == 2.0
-    assert categories["Transient - Long distraction"] == 1.5  # owl, lizard, body lean warnings
-    assert categories["Transient - Short distraction"] == 1.5
+    assert categories == {
+        "Transient - Long distraction": 3.0,  # owl, lizard, body lean: warning, forward, lane
+        "Transient - Short distraction": 3.0,
+        "Transient - Phone use": 0.0,  # no phone-use row is measured
+        "Non-transient - Impairment": 0.5,  # drowsiness' warning; its support and non-fatigue RED
+        "Non-transient - Microsleep": 2.0,
+        "Non-transient - Sleep": 2.0,
+        "Non-transient - Unresponsive": 2.0,
+    }
+    assert passed.score.points == 12.5 and passed.score.max_points == 25.0
+    answers = {(a.column, a.row, a.value) for a in passed.answers}
+    assert {("D", 70, "PASS"), ("D", 71, "PASS"), ("F", 72, "PASS")} <= answers
+    assert all(value == "PASS" for _, _, value in answers)
+    assert {"microsleep_70", "sleep_70", "unresponsive_closed_70", "unresponsive_away_70"} <= set(
+        runner.calls
+    )
 
     failing = FakeRunner(failing={"sleep_70"})
     failed = score(dossier, path, Calculator(tmp_path / "fail"), SCENARIOS, failing, True)

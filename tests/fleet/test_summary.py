@@ -64,7 +64,7 @@ def test_group_figures_are_weighted_by_frames_and_time() -> None:
     assert alice.off_road_ratio == pytest.approx((180 + 300) / (1800 + 600))
     eye_kinds = ("microsleep", "sleep", "drowsy", "unresponsive", "degraded")
     eye_kinds += ("temporary_failure", "permanent_failure")  # alert/3's failure kinds
-    eye_kinds += ("phone_use",)  # alert/4
+    eye_kinds += ("phone_use", "non_functional")  # alert/4
     assert alice.alerts == {
         "long_distraction": 3,
         "vats": 1,

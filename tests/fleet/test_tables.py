@@ -139,7 +139,7 @@ def test_the_recorder_counts_an_escalated_alert_once(tmp_path: Path) -> None:
         assert alert_writer.rows == 4
     eye_kinds = ("microsleep", "sleep", "drowsy", "unresponsive", "degraded")
     eye_kinds += ("temporary_failure", "permanent_failure")  # alert/3's failure kinds
-    eye_kinds += ("phone_use",)  # alert/4
+    eye_kinds += ("phone_use", "non_functional")  # alert/4
     assert dict(result.alert_counts) == {
         "long_distraction": 1,
         "vats": 1,

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 
 from roadgaze.conformance.model import Scenario
 from roadgaze.conformance.notices import notice_key
+from roadgaze.conformance.support import SHEET_ROWS
 from roadgaze.monitor.protocols import Rule, euroncap, support
 
 SHEET = "DE - DM pred."
@@ -175,34 +176,12 @@ _NON_TRANSIENT_ROWS = (
 
 # Forward and lane support (roadgaze.conformance.support): the scenario whose support is judged
 # for each row, and the rules behind it. `support_forward` for the forward cell, `support_lane`
-# for the lane cell; the non-transient rows' one cell needs both.
-_SUPPORT_SCENARIOS = {
-    17: "side_{driver}_70",
-    18: "centre_stack_70",
-    19: "owl_passenger_footwell_70",
-    20: "owl_passenger_face_70",
-    21: "side_{passenger}_70",
-    22: "lizard_infotainment_70",
-    23: "lizard_glovebox_70",
-    24: "lean_passenger_footwell_70",
-    25: "lean_rear_passenger_70",
-    26: "mirror_{driver}_4s_70",
-    28: "mirror_{passenger}_4s_70",
-    35: "vats_70",
-    36: "vats_owl_passenger_footwell_70",
-    37: "vats_lizard_infotainment_70",
-    38: "vats_lizard_passenger_footwell_70",
-    39: "mirror_{driver}_70",
-    41: "mirror_{passenger}_70",
-    47: "vats_lizard_multi_target_70",
-    70: "microsleep_70",
-    71: "sleep_70",
-}
+# for the lane cell; the non-transient rows' one cell needs both (`support.SHEET_ROWS`).
 _FORWARD, _LANE = support.support_rules(support.FORWARD), support.support_rules(support.LANE)
 
 
 def _with_support(row: SheetRow) -> SheetRow:
-    scenario = _SUPPORT_SCENARIOS.get(row.row)
+    scenario = SHEET_ROWS.get(row.row)
     if scenario is None:
         return row
     forward, lane = f"{scenario}.support_forward", f"{scenario}.support_lane"

@@ -21,6 +21,7 @@ from roadgaze.monitor.protocols.support import CHANNELS, support_rules
 from roadgaze.types import FrameRecord, Verdict
 
 __all__ = [
+    "SHEET_ROWS",
     "SUPPORTED",
     "SUPPORT_OUTPUTS",
     "SupportLog",
@@ -101,6 +102,32 @@ def support_requirements(
             )
         )
     return tuple(requirements)
+
+
+SHEET_ROWS: dict[int, str] = {
+    17: "side_{driver}_70",
+    18: "centre_stack_70",
+    19: "owl_passenger_footwell_70",
+    20: "owl_passenger_face_70",
+    21: "side_{passenger}_70",
+    22: "lizard_infotainment_70",
+    23: "lizard_glovebox_70",
+    24: "lean_passenger_footwell_70",
+    25: "lean_rear_passenger_70",
+    26: "mirror_{driver}_4s_70",
+    28: "mirror_{passenger}_4s_70",
+    35: "vats_70",
+    36: "vats_owl_passenger_footwell_70",
+    37: "vats_lizard_infotainment_70",
+    38: "vats_lizard_passenger_footwell_70",
+    39: "mirror_{driver}_70",
+    41: "mirror_{passenger}_70",
+    47: "vats_lizard_multi_target_70",
+    70: "microsleep_70",
+    71: "sleep_70",
+}
+"""The dossier's rows whose support cells are judged, each by one scenario's `support_forward`
+and `support_lane` (`{driver}` and `{passenger}`: the side by the cabin)."""
 
 
 def with_support(config: MonitorConfig, scenarios: list[Scenario]) -> list[Scenario]:

@@ -22,6 +22,7 @@ from roadgaze.errors import ModelError
 from roadgaze.landmarks.engines import graph as face_graph
 from roadgaze.landmarks.engines.litert import Warper, _Model
 from roadgaze.landmarks.hands import graph
+from roadgaze.landmarks.ssd_detector import SsdDetector, SsdSpec, read_model
 
 
 @dataclass(frozen=True, slots=True)
@@ -37,46 +38,8 @@ class HandArrays:
     if the image were mirrored, so on an unmirrored camera `Right` is the person's own left."""
 
 
-def _read(path: Path, what: str) -> bytes:
-    try:
-        return path.read_bytes()
-    except OSError as exc:
-        raise ModelError(
-            f"cannot read the {what} model {path}: {exc.strerror or exc}; "
-            "run `roadgaze model fetch hands`"
-        ) from None
-
-
-class PalmDetector:
-    """The palm detector: palms in an RGB image, best first, in image fractions."""
-
-    def __init__(self, path: Path, min_confidence: float, threads: int, delegate: str) -> None:
-        import cv2
-
-        self._model = _Model(_read(path, "palm detection"), path.name, threads, delegate)
-        if self._model.input_shape[1:3] != (graph.PALM_SIZE, graph.PALM_SIZE):
-            raise ModelError(
-                f"{path} takes {self._model.input_shape}, not a {graph.PALM_SIZE} px palm "
-                "detector; run `roadgaze model fetch hands --force`"
-            )
-        self._warper = Warper(graph.PALM_SIZE, cv2.BORDER_CONSTANT)
-        self._anchors = face_graph.ssd_anchors(graph.PALM_SIZE, graph.PALM_STRIDES)
-        self._min_confidence = min_confidence
-
-    def detect(self, rgb: npt.NDArray[np.uint8]) -> list[face_graph.FaceDetection]:
-        size = (rgb.shape[1], rgb.shape[0])
-        roi = face_graph.letterbox_roi(*size)
-        warped = self._warper.warp(rgb, (*roi, 0.0))
-        boxes, scores = self._model.run(warped, 1.0 / 255.0)
-        found = face_graph.decode_detections(
-            boxes[0],
-            scores[0, :, 0],
-            self._anchors,
-            self._min_confidence,
-            graph.PALM_SIZE,
-            graph.PALM_NMS_IOU,
-        )
-        return [face_graph.project_detection(palm, roi, size) for palm in found]
+PALM = SsdSpec("palm", graph.PALM_SIZE, graph.PALM_STRIDES, graph.PALM_NMS_IOU, 1.0 / 255.0)
+"""MediaPipe's palm detector (inputs 0..1)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,11 +63,11 @@ class HandLandmarker:
         import cv2
 
         self._settings = settings
-        self._detector = PalmDetector(
-            palm_path, settings.min_detection_confidence, settings.threads, settings.delegate
+        self._detector = SsdDetector(
+            PALM, palm_path, settings.min_detection_confidence, settings.threads, settings.delegate
         )
         self._model = _Model(
-            _read(landmark_path, "hand landmark"),
+            read_model(landmark_path, "hand landmark"),
             landmark_path.name,
             settings.threads,
             settings.delegate,

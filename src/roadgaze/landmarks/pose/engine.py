@@ -22,8 +22,7 @@ from roadgaze.errors import ModelError
 from roadgaze.landmarks.engines import graph as face_graph
 from roadgaze.landmarks.engines.litert import Warper, _Model
 from roadgaze.landmarks.pose import graph
-
-FETCH = "run `roadgaze model fetch hands`"
+from roadgaze.landmarks.ssd_detector import FETCH, SsdDetector, SsdSpec, read_model
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,46 +39,10 @@ class PoseArrays:
     """The model's pose flag, 0..1."""
 
 
-def _read(path: Path, what: str) -> bytes:
-    try:
-        return path.read_bytes()
-    except OSError as exc:
-        raise ModelError(
-            f"cannot read the {what} model {path}: {exc.strerror or exc}; {FETCH}"
-        ) from None
-
-
-class PoseDetector:
-    """The pose detector: bodies in an RGB image, best first, in image fractions (the box is
-    the face's, the 4 keypoints the body's)."""
-
-    def __init__(self, path: Path, min_confidence: float, threads: int, delegate: str) -> None:
-        import cv2
-
-        self._model = _Model(_read(path, "pose detection"), path.name, threads, delegate)
-        if self._model.input_shape[1:3] != (graph.DETECTOR_SIZE, graph.DETECTOR_SIZE):
-            raise ModelError(
-                f"{path} takes {self._model.input_shape}, not a {graph.DETECTOR_SIZE} px pose "
-                f"detector; {FETCH} --force"
-            )
-        self._warper = Warper(graph.DETECTOR_SIZE, cv2.BORDER_CONSTANT)
-        self._anchors = face_graph.ssd_anchors(graph.DETECTOR_SIZE, graph.DETECTOR_STRIDES)
-        self._min_confidence = min_confidence
-
-    def detect(self, rgb: npt.NDArray[np.uint8]) -> list[face_graph.FaceDetection]:
-        size = (rgb.shape[1], rgb.shape[0])
-        roi = face_graph.letterbox_roi(*size)
-        warped = self._warper.warp(rgb, (*roi, 0.0))
-        boxes, scores = self._model.run(warped, 2.0 / 255.0, -1.0)
-        found = face_graph.decode_detections(
-            boxes[0],
-            scores[0, :, 0],
-            self._anchors,
-            self._min_confidence,
-            graph.DETECTOR_SIZE,
-            graph.DETECTOR_NMS_IOU,
-        )
-        return [face_graph.project_detection(body, roi, size) for body in found]
+DETECTOR = SsdSpec(
+    "pose", graph.DETECTOR_SIZE, graph.DETECTOR_STRIDES, graph.DETECTOR_NMS_IOU, 2.0 / 255.0, -1.0
+)
+"""MediaPipe's pose detector (inputs -1..1)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,11 +65,15 @@ class PoseLandmarker:
         import cv2
 
         self._settings = settings
-        self._detector = PoseDetector(
-            detector_path, settings.min_detection_confidence, settings.threads, settings.delegate
+        self._detector = SsdDetector(
+            DETECTOR,
+            detector_path,
+            settings.min_detection_confidence,
+            settings.threads,
+            settings.delegate,
         )
         self._model = _Model(
-            _read(landmark_path, "pose landmark"),
+            read_model(landmark_path, "pose landmark"),
             landmark_path.name,
             settings.threads,
             settings.delegate,

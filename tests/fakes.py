@@ -353,6 +353,32 @@ def die_on_crash_drives(task: Any) -> Any:
     return DriveResult.of(task.drive, "ok", frames=1, duration_s=0.1)
 
 
+def face_sample(
+    t_s: float,
+    frame: int,
+    yaw_deg: float,
+    pitch_deg: float = 0.0,
+    eyes: EyesFeatures | None = None,
+    face: bool = True,
+    **extra: Any,
+) -> PoseSample:
+    """A scripted `PoseSample`: the head at `yaw_deg`, `pitch_deg` (raw and smoothed alike,
+    steady, 1 deg of spread) with `eyes` when there is a `face`, nothing measured without one;
+    `extra` sets any other field (`frame_check`, `phone`, `n_faces`, `driver_ambiguous`, ...)."""
+    measured: dict[str, Any] = {
+        "yaw_raw_deg": yaw_deg,
+        "yaw_deg": yaw_deg,
+        "yaw_rate_dps": 0.0,
+        "yaw_std_deg": 1.0,
+        "pitch_raw_deg": pitch_deg,
+        "pitch_deg": pitch_deg,
+        "eyes": eyes,
+    }
+    fields = {name: value if face else None for name, value in measured.items()}
+    fields["n_faces"] = int(face)
+    return PoseSample(t_s=t_s, frame=frame, face=face, **(fields | extra))
+
+
 def drive_monitor(
     monitor: Any,
     pose_at: Any,

@@ -8,7 +8,7 @@ from collections.abc import Callable
 
 import pytest
 
-from fakes import eyes_of
+from fakes import eyes_of, face_sample
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor import Alert, AlertKind, Monitor
 from roadgaze.types import EyesFeatures, EyeStatus, Gaze, PoseSample
@@ -29,20 +29,7 @@ def run(
     for frame in range(round(duration_s * FPS)):
         t_s = frame / FPS
         yaw_deg, eyes = script(t_s)
-        face = eyes is not None
-        sample = PoseSample(
-            t_s=t_s,
-            frame=frame,
-            face=face,
-            yaw_raw_deg=yaw_deg if face else None,
-            yaw_deg=yaw_deg if face else None,
-            yaw_rate_dps=0.0 if face else None,
-            yaw_std_deg=1.0 if face else None,
-            n_faces=int(face),
-            pitch_raw_deg=0.0 if face else None,
-            pitch_deg=0.0 if face else None,
-            eyes=eyes,
-        )
+        sample = face_sample(t_s, frame, yaw_deg, eyes=eyes, face=eyes is not None)
         alerts.extend(monitor.update(sample, None))
     return monitor, alerts
 

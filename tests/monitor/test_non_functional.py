@@ -9,7 +9,7 @@ from collections.abc import Callable
 
 import pytest
 
-from fakes import BLANK_FRAME, eyes_of
+from fakes import BLANK_FRAME, eyes_of, face_sample
 from roadgaze.config import Config, MonitorConfig
 from roadgaze.monitor import Alert, AlertKind, Monitor
 from roadgaze.monitor.behaviours.non_functional import notice_in
@@ -31,21 +31,7 @@ Script = Callable[[float], tuple[float, EyesFeatures | None]]
 def sample(t_s: float, frame: int, yaw_deg: float, eyes: EyesFeatures | None) -> PoseSample:
     check = BLACK if eyes is BLACKED else GOOD
     eyes = None if eyes is BLACKED else eyes
-    face = eyes is not None
-    return PoseSample(
-        t_s=t_s,
-        frame=frame,
-        face=face,
-        yaw_raw_deg=yaw_deg if face else None,
-        yaw_deg=yaw_deg if face else None,
-        yaw_rate_dps=0.0 if face else None,
-        yaw_std_deg=1.0 if face else None,
-        n_faces=int(face),
-        pitch_raw_deg=0.0 if face else None,
-        pitch_deg=0.0 if face else None,
-        eyes=eyes,
-        frame_check=check,
-    )
+    return face_sample(t_s, frame, yaw_deg, eyes=eyes, face=eyes is not None, frame_check=check)
 
 
 def run(

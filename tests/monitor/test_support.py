@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import pytest
 
-from fakes import eyes_of
+from fakes import eyes_of, face_sample
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor import Monitor
 from roadgaze.monitor.behaviours.support import support_output
@@ -26,7 +26,6 @@ from roadgaze.types import (
     Output,
     PhoneJudgement,
     PhonePose,
-    PoseSample,
 )
 
 FPS = 15.0
@@ -64,18 +63,14 @@ def drive(
         t_s = frame / FPS
         pose = script(t_s)
         face = pose.face
-        sample = PoseSample(
-            t_s=t_s,
-            frame=frame,
-            face=face,
-            yaw_raw_deg=pose.yaw_deg if face else None,
-            yaw_deg=pose.yaw_deg if face else None,
-            yaw_rate_dps=0.0 if face else None,
-            yaw_std_deg=1.0 if face else None,
+        sample = face_sample(
+            t_s,
+            frame,
+            pose.yaw_deg,
+            pose.pitch_deg,
+            pose.eyes,
+            face,
             n_faces=2 if pose.ambiguous else int(face),
-            pitch_raw_deg=pose.pitch_deg if face else None,
-            pitch_deg=pose.pitch_deg if face else None,
-            eyes=pose.eyes if face else None,
             driver_ambiguous=pose.ambiguous,
             phone=pose.phone,
         )

@@ -3,10 +3,15 @@ to (tests/landmarks/test_hands.py, test_pose.py)."""
 
 from __future__ import annotations
 
+import csv
+import json
 import subprocess
 import venv
 from pathlib import Path
+from typing import Any
 
+import numpy as np
+import numpy.typing as npt
 import pytest
 
 REFERENCE_PACKAGES = (
@@ -38,3 +43,35 @@ def reference_python(cache: Path) -> Path:
             pytest.skip(f"cannot install the reference mediapipe 0.10.14: {done.stderr[-300:]}")
     (folder / "ready").write_text("ok\n")
     return python
+
+
+def reference_on_drivers(
+    cache: Path, script: str, every: int, folder: Path
+) -> tuple[dict[str, npt.NDArray[np.uint8]], Any]:
+    """Every `every`-th State Farm development image (RGB, by its file with `/` as `_`) and what
+    `scripts/<script>` prints for them under MediaPipe 0.10.14 (its JSON, read back)."""
+    import cv2
+
+    from repo_paths import REPO, STATEFARM
+
+    with (STATEFARM / "ground_truth.csv").open(encoding="utf-8") as stream:
+        rows = list(csv.DictReader(stream))[::every]
+    images = {
+        row["file"].replace("/", "_"): np.ascontiguousarray(
+            cv2.imread(str(STATEFARM / row["file"]))[:, :, ::-1]
+        )
+        for row in rows
+    }
+    np.savez(folder / "images.npz", **images)
+    subprocess.run(
+        [
+            str(reference_python(cache)),
+            str(REPO / "scripts" / script),
+            str(folder / "images.npz"),
+            str(folder / "reference.json"),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=600,
+    )
+    return images, json.loads((folder / "reference.json").read_text())

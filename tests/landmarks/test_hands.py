@@ -3,17 +3,14 @@ MediaPipe 0.10.14's own hand graph on real drivers (State Farm development image
 
 from __future__ import annotations
 
-import csv
-import json
 import math
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from mediapipe_reference import reference_python
-from repo_paths import REPO, STATEFARM
+from mediapipe_reference import reference_on_drivers
+from repo_paths import STATEFARM
 from roadgaze.config import load_config
 from roadgaze.errors import ModelError
 from roadgaze.landmarks.engines.graph import FaceDetection, Rect
@@ -95,7 +92,6 @@ def test_a_corrupt_model_is_one_line_naming_it(tmp_path: Path) -> None:
 def reference_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, dict, Path]:
     if not (STATEFARM / "ground_truth.csv").is_file():
         pytest.skip(f"no State Farm development images at {STATEFARM}")
-    import cv2
 
     from roadgaze.landmarks.hands.models import fetch_hand_models, model_names
     from roadgaze.landmarks.model_store import default_cache_dir
@@ -105,30 +101,11 @@ def reference_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, dict,
         fetch_hand_models(config, model_names("full", "full"))
     except ModelError as exc:
         pytest.skip(f"hand models unavailable: {exc}")
-    with (STATEFARM / "ground_truth.csv").open(encoding="utf-8") as stream:
-        rows = list(csv.DictReader(stream))[::80]  # 21 images, every class and most drivers
-    images = {
-        row["file"].replace("/", "_"): np.ascontiguousarray(
-            cv2.imread(str(STATEFARM / row["file"]))[:, :, ::-1]
-        )
-        for row in rows
-    }
     folder = tmp_path_factory.mktemp("hands-reference")
-    np.savez(folder / "images.npz", **images)
-    python = reference_python(default_cache_dir(config))
-    subprocess.run(
-        [
-            str(python),
-            str(REPO / "scripts" / "hands-reference.py"),
-            str(folder / "images.npz"),
-            str(folder / "reference.json"),
-        ],
-        check=True,
-        capture_output=True,
-        timeout=600,
-    )
-    reference = json.loads((folder / "reference.json").read_text())
-    return images, reference, default_cache_dir(config)
+    cache = default_cache_dir(config)
+    # 21 images: every class and most drivers
+    images, reference = reference_on_drivers(cache, "hands-reference.py", 80, folder)
+    return images, reference, cache
 
 
 def test_litert_hands_equal_mediapipe_0_10_14_on_real_drivers(reference_run: tuple) -> None:

@@ -49,7 +49,7 @@ def exit_now(code: int) -> None:
     for handler in logging.getLogger().handlers:
         handler.flush()
     for stream in (sys.stdout, sys.stderr):
-        with suppress(OSError, ValueError):  # a closed pipe: nothing more to say
+        with suppress(OSError, ValueError, RuntimeError):  # a closed pipe, a re-entrant call
             stream.flush()
     os._exit(code)
 
@@ -65,22 +65,33 @@ def signal_handlers(
     once with status 1, at any spacing. `doing` says in the log what happens next, under the
     logger `log_name`.
 
+    The handler itself only writes the signal's number into a pipe: a thread (`_SignalWatch`)
+    logs it, sets `stop` and, for a second signal, exits. A Python signal handler runs in the
+    main thread between two of its bytecodes, possibly while that thread holds a lock that is
+    not re-entrant (a `queue.Queue`'s, which the recorder's log tap takes, or a
+    `threading.Event`'s): logging or setting an event from the handler can then wait forever
+    on its own thread. It did: one SIGTERM in a few hundred hung the daemon with a recorder.
+
     With `hard_exit` the second signal ends the process right there (`os._exit` after the log is
-    flushed): raising SystemExit from a signal handler can land inside a finaliser (MediaPipe's
+    flushed): raising SystemExit can land inside a finaliser (MediaPipe's
     `FaceLandmarker.__del__`), where Python prints "Exception ignored" and goes on. Without it
-    (the batch, which must stop its worker processes) it raises SystemExit(1).
+    (the batch, which must stop its worker processes) the handler raises SystemExit(1) in the
+    main thread.
     """
-    logger = logging.getLogger(log_name)
+    watch = _SignalWatch(stop, doing, logging.getLogger(log_name), hard_exit)
+    owner_pid = os.getpid()
+    received = 0
 
     def on_signal(number: int, frame: FrameType | None) -> None:
-        name = signal.Signals(number).name
-        if stop.is_set():
-            logger.warning("second %s: exiting without waiting (exit status 1)", name)
-            if not hard_exit:
-                raise SystemExit(EXIT_SECOND_SIGNAL)
-            exit_now(EXIT_SECOND_SIGNAL)
-        logger.info("%s received: %s", name, doing)
-        stop.set(name)
+        nonlocal received
+        if os.getpid() != owner_pid:  # a forked child: the default action, as if never set
+            signal.signal(number, signal.SIG_DFL)
+            os.kill(os.getpid(), number)
+            return
+        received += 1
+        watch.post(number)
+        if received > 1 and not hard_exit:
+            raise SystemExit(EXIT_SECOND_SIGNAL)
 
     previous = {number: signal.signal(number, on_signal) for number in STOP_SIGNALS}
     try:
@@ -88,6 +99,51 @@ def signal_handlers(
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
+        watch.close()
+
+
+class _SignalWatch:
+    """The thread that acts on the signals `post`ed through a pipe (os.write takes no lock)."""
+
+    _CLOSE = 0
+
+    def __init__(self, stop: StopFlag, doing: str, logger: logging.Logger, hard_exit: bool) -> None:
+        self.stop, self.doing, self.logger, self.hard_exit = stop, doing, logger, hard_exit
+        self._read_fd, self._write_fd = os.pipe()
+        os.set_blocking(self._write_fd, False)
+        self._thread = threading.Thread(target=self._watch, name="roadgaze-signals", daemon=True)
+        self._thread.start()
+
+    def post(self, number: int) -> None:
+        """From the signal handler: no lock, never waits (a full pipe drops the byte; the
+        signals already in it say the same)."""
+        with suppress(OSError):
+            os.write(self._write_fd, bytes((number,)))
+
+    def close(self) -> None:
+        with suppress(OSError):
+            os.set_blocking(self._write_fd, True)
+            os.write(self._write_fd, bytes((self._CLOSE,)))
+        self._thread.join(timeout=5.0)
+        for descriptor in (self._read_fd, self._write_fd):
+            with suppress(OSError):
+                os.close(descriptor)
+
+    def _watch(self) -> None:
+        while data := os.read(self._read_fd, 64):
+            for number in data:
+                if number == self._CLOSE:
+                    return
+                self._act(signal.Signals(number).name)
+
+    def _act(self, name: str) -> None:
+        if self.stop.is_set():
+            self.logger.warning("second %s: exiting without waiting (exit status 1)", name)
+            if self.hard_exit:
+                exit_now(EXIT_SECOND_SIGNAL)
+            return  # the batch: the handler raised SystemExit in the main thread
+        self.logger.info("%s received: %s", name, self.doing)
+        self.stop.set(name)
 
 
 @contextmanager

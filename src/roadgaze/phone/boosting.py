@@ -36,8 +36,24 @@ def _edges(column: FloatArray, bins: int) -> FloatArray:
 
 
 class _TreeBuilder:
-    def __init__(self, x: FloatArray, edges: list[FloatArray], settings: BoostSettings) -> None:
-        self.x, self.edges, self.settings = x, edges, settings
+    """One tree, grown on the rows' bin numbers (`binned`: for each row and feature, how many of
+    the feature's thresholds lie below its value), every feature's split scored at once."""
+
+    def __init__(
+        self,
+        x: FloatArray,
+        binned: npt.NDArray[np.intp],
+        edges: list[FloatArray],
+        settings: BoostSettings,
+    ) -> None:
+        self.x, self.binned, self.edges, self.settings = x, binned, edges, settings
+        self.width = max((e.size for e in edges), default=0) + 1
+        """Bins per feature in the flat histograms (the widest feature's thresholds + 1)."""
+        self.candidate = (
+            np.arange(self.width - 1)[None, :] < np.array([e.size for e in edges])[:, None]
+        )
+        """[feature, threshold]: whether that feature has that threshold."""
+        self.offsets = np.arange(len(edges), dtype=np.intp) * self.width
         self.feature: list[int] = []
         self.threshold: list[float] = []
         self.left: list[int] = []
@@ -68,35 +84,47 @@ class _TreeBuilder:
         self.right[node] = self.build(rows[~goes_left], g, h, depth - 1)
         return node
 
+    def _cumulative(
+        self, flat: npt.NDArray[np.intp], weights: FloatArray | None
+    ) -> npt.NDArray[Any]:
+        """Per feature and threshold: the sum of `weights` (None: the count) over the rows at
+        or below it."""
+        size = len(self.edges) * self.width
+        histogram = np.bincount(flat, weights, size).reshape(len(self.edges), self.width)
+        cumulative: npt.NDArray[Any] = np.cumsum(histogram, axis=1)[:, :-1]
+        return cumulative
+
     def _best_split(
         self, rows: npt.NDArray[np.intp], g: FloatArray, h: FloatArray
     ) -> tuple[int, float] | None:
+        """The (feature, threshold) of the largest gain above zero; ties go to the first feature
+        and the lowest threshold."""
         settings = self.settings
+        if self.width == 1:
+            return None
         g_rows, h_rows = g[rows], h[rows]
         g_total, h_total = g_rows.sum(), h_rows.sum()
         parent = g_total**2 / (h_total + settings.l2)
-        best_gain, best = 1e-9, None
-        for feature, edges in enumerate(self.edges):
-            if edges.size == 0:
-                continue
-            column = self.x[rows, feature]
-            bucket = np.searchsorted(edges, column, side="left")
-            g_cum = np.cumsum(np.bincount(bucket, g_rows, edges.size + 1))[:-1]
-            h_cum = np.cumsum(np.bincount(bucket, h_rows, edges.size + 1))[:-1]
-            n_cum = np.cumsum(np.bincount(bucket, minlength=edges.size + 1))[:-1]
-            ok = (n_cum >= settings.min_leaf) & (rows.size - n_cum >= settings.min_leaf)
-            if not ok.any():
-                continue
-            gain = (
-                g_cum**2 / (h_cum + settings.l2)
-                + (g_total - g_cum) ** 2 / (h_total - h_cum + settings.l2)
-                - parent
-            )
-            gain = np.where(ok, gain, -np.inf)
-            index = int(np.argmax(gain))
-            if gain[index] > best_gain:
-                best_gain, best = float(gain[index]), (feature, float(edges[index]))
-        return best
+        features = len(self.edges)
+        flat = (self.binned[rows] + self.offsets).ravel()
+        g_cum = self._cumulative(flat, np.repeat(g_rows, features))
+        h_cum = self._cumulative(flat, np.repeat(h_rows, features))
+        n_cum = self._cumulative(flat, None)
+        ok = (
+            self.candidate & (n_cum >= settings.min_leaf) & (rows.size - n_cum >= settings.min_leaf)
+        )
+        if not ok.any():
+            return None
+        gain = (
+            g_cum**2 / (h_cum + settings.l2)
+            + (g_total - g_cum) ** 2 / (h_total - h_cum + settings.l2)
+            - parent
+        )
+        gain = np.where(ok, gain, -np.inf)
+        feature, index = np.unravel_index(int(np.argmax(gain)), gain.shape)
+        if not gain[feature, index] > 1e-9:
+            return None
+        return int(feature), float(self.edges[feature][index])
 
 
 def fit(x: FloatArray, y: npt.NDArray[np.integer], settings: BoostSettings) -> dict[str, Any]:
@@ -107,12 +135,15 @@ def fit(x: FloatArray, y: npt.NDArray[np.integer], settings: BoostSettings) -> d
     baseline = float(np.log(rate / (1 - rate)))
     raw = np.full(labels.size, baseline)
     edges = [_edges(x[:, column], settings.bins) for column in range(x.shape[1])]
+    binned = np.stack(
+        [np.searchsorted(e, x[:, column], side="left") for column, e in enumerate(edges)], axis=1
+    ).astype(np.intp)
     trees: list[dict[str, Any]] = []
     rows = np.arange(labels.size)
     for _ in range(settings.trees):
         probability = 1.0 / (1.0 + np.exp(-raw))
         gradient, hessian = probability - labels, probability * (1 - probability)
-        builder = _TreeBuilder(x, edges, settings)
+        builder = _TreeBuilder(x, binned, edges, settings)
         builder.build(rows, gradient, hessian, settings.depth)
         tree = {
             "feature": builder.feature,

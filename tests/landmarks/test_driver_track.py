@@ -71,6 +71,23 @@ def test_a_driver_who_comes_back_at_another_place_is_picked_again() -> None:
     assert chosen == [1, 1, 1, 1]
 
 
+def test_a_false_find_while_the_drivers_face_is_lost_does_not_keep_the_driver_out() -> None:
+    """At night, with the driver's face turned down and lost, a headrest found as a face above
+    it was picked as the driver; the driver's face, back a frame later and ever after, was then
+    taken for someone else (the boxes of a rendered night drive). The driver's track the false
+    find replaced takes it back, and the false find is someone else."""
+    tracker = DriverTracker("seat", 1)
+    driver, headrest = Face(76, 84, 125), Face(95, 90, 30)
+    chosen = run(tracker, [[driver]] * 5 + [[]] * 2 + [[headrest]] + [[Face(80, 84, 126), headrest]]
+                 + [[Face(84, 86, 124)]] * 20)  # fmt: skip
+    assert chosen == [0] * 5 + [None] * 2 + [0] + [0] + [0] * 20
+    # The driver gone for good: the new pick keeps the place once the old track is forgotten.
+    tracker = DriverTracker("seat", 1)
+    late = round((OTHER_TRACK_KEEP_S + 1.0) * 10)
+    chosen = run(tracker, [[driver]] * 3 + [[headrest]] * late + [[Face(80, 84, 126), headrest]])
+    assert chosen[3:] == [0] * late + [1]
+
+
 def test_a_passenger_unseen_for_long_is_forgotten() -> None:
     tracker = DriverTracker("seat", 1)
     tracker.step([Face(40, 100), Face(300, 100)], 0.0)

@@ -16,6 +16,12 @@ the `seat` rule (the default):
 - **The first pick**, and a new pick when the driver's face is lost and a face no track knows
   appears (the driver back at another place, or someone new): the seat rule among those faces
   (`roadgaze.landmarks.seat.seat_pick`).
+- **A new pick is on probation.** The driver's track it replaced is kept `OTHER_TRACK_KEEP_S`
+  after it was last matched; a face continuing it is the driver again, whatever the new pick
+  shows, and the new pick becomes someone else. A false find while the driver's face is lost
+  (at night, a headrest or hair found as a face above a face turned down) otherwise took the
+  driver's track, and the driver, back at the road a second later, was taken for someone else
+  for as long as it stayed in view.
 - **A recording's choice.** When the frame comes from a recording that kept its driver's box
   (`roadgaze.types.RecordedDriver`), the driver is the face overlapping that box by at least
   `DRIVER_MATCH_IOU`, none when no face does or the recording had none: a drive and its
@@ -117,6 +123,8 @@ class DriverTracker:
         self.side = rule_side(rule, seat_side)
         self.box_px: Box | None = None
         self._driver: _Track | None = None
+        self._replaced: _Track | None = None
+        """The driver's track a new pick replaced (see the module doc), until it is too old."""
         self._others: list[_Track] = []
         self.ambiguous = ""
         self._warned_t_s = -math.inf
@@ -141,11 +149,24 @@ class DriverTracker:
 
     def _seat_step(self, boxes: list[Box], t_s: float) -> int | None:
         self._others = [t for t in self._others if t_s - t.seen_t_s <= OTHER_TRACK_KEEP_S]
+        replaced = self._replaced
+        if replaced is not None and t_s - replaced.seen_t_s > OTHER_TRACK_KEEP_S:
+            replaced = self._replaced = None
         tracks = [track.box_px for track in self._others]
+        driver_track = replaced_track = -1
         if self._driver is not None:
+            driver_track = len(tracks)
             tracks.append(self._driver.box_px)
+        if replaced is not None:
+            replaced_track = len(tracks)
+            tracks.append(replaced.box_px)
         matched = match(tracks, boxes)
-        driver_track = len(self._others) if self._driver is not None else -1
+        for face, track in matched.items():
+            if track == replaced_track:  # the driver before the new pick: the driver again
+                if self._driver is not None:
+                    self._others.append(self._driver)
+                self._driver, self._replaced = replaced, None
+                return face
         for face, track in matched.items():
             if track == driver_track:
                 return face
@@ -157,7 +178,11 @@ class DriverTracker:
             if face not in matched and area(boxes[face]) >= least_px2
         ]
         chosen = seat_pick([_Boxed(boxes[face]) for face in unknown], self.side)
-        return None if chosen is None else unknown[chosen]
+        if chosen is None:
+            return None
+        if self._driver is not None and self._replaced is None:  # the driver's face is lost
+            self._replaced = self._driver  # (on a second new pick, the first driver is kept)
+        return unknown[chosen]
 
     def _remember(self, boxes: list[Box], index: int | None, t_s: float) -> None:
         """The driver's track and the others' after this frame's choice."""

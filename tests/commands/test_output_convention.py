@@ -4,6 +4,7 @@ told once (`roadgaze.logs`)."""
 
 from __future__ import annotations
 
+import csv
 import json
 import logging
 import re
@@ -117,6 +118,16 @@ def test_replay_out_file_keeps_stdout_empty(
     assert wrote(err) == [str(out_path), str(table)]
     assert main(["replay", str(glance_clip), "--out", "-", "--no-progress"]) == 0
     assert len(capsys.readouterr().out.splitlines()) == round(5.8 * 15)
+    # Each file in its option's format whatever its name, offline columns filled: `--out
+    # rec.csv` (JSON lines) was read back as CSV and its offline columns left null.
+    out_path, table = tmp_path / "rec.csv", tmp_path / "rec.jsonl"
+    assert main([*args[:2], "--out", str(out_path), "--csv", str(table), "--no-progress"]) == 0
+    assert "offline columns left null" not in capsys.readouterr().err
+    records = [json.loads(line) for line in out_path.read_text().splitlines()]
+    assert sum(r["yaw_offline_deg"] is not None for r in records) > 0.9 * len(records)
+    with table.open(newline="") as stream:
+        rows = list(csv.DictReader(stream))
+    assert sum(row["yaw_offline_deg"] != "" for row in rows) > 0.9 * len(rows)
 
 
 @pytest.mark.slow

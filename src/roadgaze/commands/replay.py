@@ -212,11 +212,12 @@ def fill_offline(args: argparse.Namespace, config: Config) -> None:
     from roadgaze.errors import RoadgazeError
     from roadgaze.outputs import fill_offline_columns
 
-    paths = [Path(args.out)] if args.out is not None and args.out != "-" else []
-    paths += [args.csv] if args.csv is not None else []
-    for path in paths:
+    # Each file in the format its option writes, whatever its name (`--out rec.csv` is JSON).
+    paths = [(Path(args.out), False)] if args.out is not None and args.out != "-" else []
+    paths += [(args.csv, True)] if args.csv is not None else []
+    for path, csv_format in paths:
         try:
-            fill_offline_columns(path, config.smoothing)
+            fill_offline_columns(path, config.smoothing, csv_format)
         except RoadgazeError as exc:
             log.warning("replay %s: offline columns left null: %s", args.source, exc)
             continue

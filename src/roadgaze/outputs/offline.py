@@ -67,14 +67,18 @@ def _offline(path: Path, csv_format: bool, smoothing: SmoothingConfig) -> Offlin
         raise RoadgazeError(f"{path}: cannot run the offline pass: {exc}") from None
 
 
-def fill_offline_columns(path: str | Path, smoothing: SmoothingConfig | None = None) -> int:
-    """Rewrite a frame-record file (`.csv`: CSV, else JSON lines) with the offline columns filled.
+def fill_offline_columns(
+    path: str | Path, smoothing: SmoothingConfig | None = None, csv_format: bool | None = None
+) -> int:
+    """Rewrite a frame-record file (CSV when `csv_format`, else JSON lines; None: CSV for a
+    `.csv` name) with the offline columns filled.
 
     Returns the number of records. Raises RoadgazeError for an unreadable file or one whose
     times do not increase; the original file is then left as it was.
     """
     path = Path(path)
-    csv_format = path.suffix.lower() == ".csv"
+    if csv_format is None:
+        csv_format = path.suffix.lower() == ".csv"
     smoothing = smoothing if smoothing is not None else SmoothingConfig()
     try:
         pose = _offline(path, csv_format, smoothing)

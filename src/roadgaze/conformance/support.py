@@ -15,6 +15,7 @@ from dataclasses import replace
 
 from roadgaze.config import MonitorConfig
 from roadgaze.config.support import SUPPORT_RAISE_MAX_S
+from roadgaze.conformance.driving_task import DRIVING_TASK_ROWS, driving_task_scenarios
 from roadgaze.conformance.model import Requirement, Scenario, Segment
 from roadgaze.monitor.behaviours.support import HEIGHTENED, NORMAL, output_name
 from roadgaze.monitor.protocols.support import CHANNELS, support_rules
@@ -125,9 +126,10 @@ SHEET_ROWS: dict[int, str] = {
     47: "vats_lizard_multi_target_70",
     70: "microsleep_70",
     71: "sleep_70",
-}
+} | {row: look.scenario for row, look in DRIVING_TASK_ROWS.items()}
 """The dossier's rows whose support cells are judged, each by one scenario's `support_forward`
-and `support_lane` (`{driver}` and `{passenger}`: the side by the cabin)."""
+and `support_lane` (`{driver}` and `{passenger}`: the side by the cabin; the driving-task looks
+of `roadgaze.conformance.driving_task` included)."""
 
 
 def with_support(config: MonitorConfig, scenarios: list[Scenario]) -> list[Scenario]:
@@ -143,7 +145,8 @@ def with_support(config: MonitorConfig, scenarios: list[Scenario]) -> list[Scena
 
 
 def support_scenarios(config: MonitorConfig) -> list[Scenario]:
-    """A 4 s look at each side mirror at 70 km/h: a long driving-task glance, support only."""
+    """A 4 s look at each side mirror at 70 km/h: a long driving-task glance, support only; then
+    the other driving-task looks (`roadgaze.conformance.driving_task`)."""
     from roadgaze.conformance.matrix import FAST_KMH, LOOK_S, ahead, back, look, zone_target
 
     scenarios = []
@@ -154,7 +157,7 @@ def support_scenarios(config: MonitorConfig) -> list[Scenario]:
         segments: tuple[Segment, ...] = (ahead(), look(target, LOOK_S), back())
         requirements = support_requirements(config, name, "look", "back")
         scenarios.append(Scenario(name, text, segments, FAST_KMH, requirements))
-    return scenarios
+    return [*scenarios, *driving_task_scenarios(config)]
 
 
 def judge_support(

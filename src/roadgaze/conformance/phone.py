@@ -1,7 +1,9 @@
 """The scenarios of advanced phone use (Euro NCAP 2026, the dossier's phone rows): the driver
-looks at the road at 70 km/h, then holds a phone up in the outer hand for `HOLD_S`, the eyes
-still near the road, then puts it down. The service must warn (`phone_use`) within the rule's
-time of the phone coming up, and heighten forward and lane support with the warning.
+looks at the road at 70 km/h, then holds a phone up in the outer hand for `HOLD_S`, the head
+still on the road and the eyes on the phone (the sheet's "lizard"), then puts it down. The
+service must warn (`phone_use`) within the rule's time of the phone coming up, and heighten
+forward and lane support by then (earlier is as good: the eyes on the phone may already be off
+the road).
 
 The phone is held at the wheel (9-11 o'clock in a left-hand-drive cabin, 1-3 in a right-hand-
 drive one) or higher, beside the face in view of the windscreen (`roadgaze.synth.phone_hand`),
@@ -43,7 +45,7 @@ def phone_name(place: str) -> str:
 
 def phone_scenarios(config: MonitorConfig) -> list[Scenario]:
     """A phone held up `HOLD_S` at each of `PLACES` at 70 km/h: `phone_use` within the rule's
-    time, support heightened with it until the phone is put down."""
+    time, support heightened by then until the phone is put down."""
     scenarios = []
     outer = 1.0 if config.cabin == "lhd" else -1.0
     for place, (what, (eye_yaw_deg, eye_pitch_deg)) in PLACES.items():
@@ -55,9 +57,9 @@ def phone_scenarios(config: MonitorConfig) -> list[Scenario]:
         support = tuple(
             replace(
                 requirement,
-                text=f"{requirement.text.partition(' within')[0]} with the warning, held until "
-                "the phone is put down",
-                window_s=warns.window_s,
+                text=f"{requirement.text.partition(' within')[0]} by the warning at the "
+                "latest, held until the phone is put down",
+                window_s=(0.0, late_s + DETECT_LATENCY_S),
                 applies=warns.applies,
             )
             for requirement in support_requirements(config, name, "phone", "back")

@@ -59,7 +59,8 @@ class PhoneJudgement:
     phone_use: bool | None
     """A phone in hand; None when it cannot be judged (no hand found and no face)."""
     score: float | None
-    """0..1, `phone_use` is `score >= threshold`; None when it cannot be judged."""
+    """The classifier's 0..1: `phone_use` is `score >= threshold`, or a hand held up in front of
+    a camera facing the driver (`roadgaze.phone.held_up`); None when it cannot be judged."""
     hand: HandSide | None = None
     """The hand that holds it (the one scoring highest); None without a phone."""
     pose: PhonePose | None = None

@@ -6,7 +6,8 @@ pose of 0, 0 in the camera's frame faces the lens: the photo's own downward look
 `HeadFrame.facing_pitch_deg`, is nodded away), dressed in what the scenario's `conditions` name
 (`roadgaze.synth.outfit`: glasses, a mask, a beard, a cap, ...), the jaw moving with speech when
 it is `talking` and opening as its segments yawn (`mouth_track`), a hand on the wheel where the
-camera sees it (`hand_at_12`); sensor noise goes on every frame (a held pose is not a frozen
+camera sees it (`hand_at_12`), a phone held up in the outer hand (`phone_wheel`,
+`phone_windscreen`); sensor noise goes on every frame (a held pose is not a frozen
 camera), or at `night` the infrared picture with its own noise (`roadgaze.synth.effects.night`).
 A covered lens is a dark flat frame, no face the cabin without the driver, frozen frames the
 last frame again, byte for byte. `RenderedSource` hands the frames to the loop
@@ -37,6 +38,7 @@ from roadgaze.synth.lean import leaned
 from roadgaze.synth.mouth import speech_track
 from roadgaze.synth.occluders import hand_layer
 from roadgaze.synth.outfit import WORN, Outfit, check_conditions
+from roadgaze.synth.phone_hand import PLACES, phone_hand_layer
 from roadgaze.synth.renderer import ImageBGR
 from roadgaze.synth.timeline import DEFAULT_TRANSITION_S, Keyframe, Timeline, eased
 from roadgaze.types import FloatArray, Frame
@@ -121,6 +123,7 @@ class ScenarioRenderer:
         """Added to every rendered pitch: the photo's face looks this far below its camera."""
         self._outfits: dict[tuple[str, ...], Outfit] = {}
         self._hands: dict[str, Layer | None] = {}
+        self._phones: dict[str, Layer] = {}
 
     def outfit(self, conditions: tuple[str, ...]) -> Outfit:
         """The face dressed in the worn ones of `conditions` (built once per combination)."""
@@ -137,6 +140,19 @@ class ScenarioRenderer:
             self._hands[preset] = hand_layer(self.renderer, preset, self.cabin, rest)
         return self._hands[preset]
 
+    def _phone(self, scenario: Scenario, place: str) -> Layer:
+        """A phone held up at `place` (`roadgaze.synth.phone_hand`) as the scenario's camera
+        sees it through its lens (built once per camera, place and zoom)."""
+        key = f"{scenario.mounting}/{place}/{scenario.zoom:g}"
+        if key not in self._phones:
+            mounting = mounting_for(scenario.mounting, self.cabin)
+            road_yaw, road_pitch, _ = head_to_camera(mounting, 0.0, 0.0)
+            rest = (road_yaw, road_pitch + self.facing_pitch_deg)
+            self._phones[key] = phone_hand_layer(
+                self.renderer, place, self.cabin, rest, scenario.zoom
+            )
+        return self._phones[key]
+
     def _face(
         self,
         scenario: Scenario,
@@ -149,7 +165,10 @@ class ScenarioRenderer:
         yaw, camera_pitch, _ = head_to_camera(mounting, float(row[1]), float(row[2]))
         pitch = camera_pitch + self.facing_pitch_deg
         worn = scenario.conditions
-        if scenario.worn_from and float(row[0]) < scenario.start_of(scenario.worn_from) - 1e-9:
+        t_s = float(row[0])
+        if scenario.worn_from and t_s < scenario.start_of(scenario.worn_from) - 1e-9:
+            worn = ()
+        if scenario.worn_until and t_s >= scenario.start_of(scenario.worn_until) - 1e-9:
             worn = ()
         lean = (float(lean_m[0]), float(lean_m[1]), float(lean_m[2]))
         values = (yaw, pitch, *row[3:6], mouth_open, *lean, len(worn))
@@ -162,6 +181,9 @@ class ScenarioRenderer:
             width_px = self.renderer.mesh.face_width_px
             frame = leaned(frame, width_px, mounting, lean, scenario.zoom)
             frame = frame if hand is None else hand.over(frame)
+            for place in PLACES:
+                if f"phone_{place}" in worn:
+                    frame = self._phone(scenario, place).over(frame)
             cache[key] = frame
         return cache[key]
 

@@ -145,6 +145,8 @@ _SHORT_ROWS = (
     _row(47, SHORT, "Multi-target", "Lizard", "", VATS, _vats("lizard_multi_target")),
 )
 BASIC, ADVANCED = "Basic phone use", "Advanced phone use"
+_PHONE_USE = (euroncap.PHONE_USE,)
+_WHEEL, _SCREEN = ("phone_wheel_70.warns",), ("phone_windscreen_70.warns",)
 _PHONE_ROWS = (
     _row(51, PHONE, BASIC, "Owl", "Phone mounted on dashboard outboard", ()),
     _row(52, PHONE, BASIC, "Owl", "Driver knee outboard", ()),
@@ -157,8 +159,9 @@ _PHONE_ROWS = (
     _row(59, PHONE, BASIC, "Lizard", "Phone mounted on dedicated position", ()),
     _row(60, PHONE, BASIC, "Lizard", "Phone held centre of steering wheel", ()),
     _row(61, PHONE, ADVANCED, "Lizard", "Phone mounted on dashboard outboard", ()),
-    _row(62, PHONE, ADVANCED, "Lizard", "Phone held in 9-11 or 1-3 o'clock", ()),
-    _row(63, PHONE, ADVANCED, "Lizard", "Phone held in view of windscreen", ()),
+    # A phone held up (roadgaze.conformance.phone): the hand seen, the eyes on the phone.
+    _row(62, PHONE, ADVANCED, "Lizard", "Phone held in 9-11 or 1-3 o'clock", _PHONE_USE, _WHEEL),
+    _row(63, PHONE, ADVANCED, "Lizard", "Phone held in view of windscreen", _PHONE_USE, _SCREEN),
     _row(64, PHONE, ADVANCED, "Lizard", "Phone held in view of instrument cluster", ()),
 )
 # Drowsiness (impairment by fatigue): roadgaze.conformance.drowsiness.

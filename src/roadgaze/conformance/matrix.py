@@ -235,6 +235,7 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
     from roadgaze.conformance.drowsiness import drowsiness_scenarios
     from roadgaze.conformance.locations import location_scenarios
     from roadgaze.conformance.notices import notice_scenarios
+    from roadgaze.conformance.phone import phone_scenarios
     from roadgaze.conformance.support import support_scenarios, with_support
     from roadgaze.conformance.timers import camera_scenarios, eye_scenarios, vats_scenarios
 
@@ -249,6 +250,8 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
         *drowsiness_scenarios(config),
         # The non-functional notices (Euro NCAP general requirements).
         *notice_scenarios(config),
+        # Advanced phone use: a phone held up (roadgaze.conformance.phone).
+        *phone_scenarios(config),
     ]
     # Forward and lane support: judged on the scenarios of roadgaze.conformance.support.SUPPORTED,
     # and the long mirror looks of its own.

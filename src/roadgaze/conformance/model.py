@@ -84,6 +84,9 @@ class Scenario:
     worn_from: str = ""
     """The label of the segment from whose start the worn conditions (and the hand on the
     wheel) are put on ('': from the first frame); `night` and `talking` hold throughout."""
+    worn_until: str = ""
+    """The label of the segment from whose start the worn conditions are taken off again ('':
+    worn to the end): a phone put down."""
     fast: bool = False
     """Part of the `--fast` subset (the test suite's)."""
     zoom: float = 1.0

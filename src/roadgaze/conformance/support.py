@@ -124,6 +124,8 @@ SHEET_ROWS: dict[int, str] = {
     39: "mirror_{driver}_70",
     41: "mirror_{passenger}_70",
     47: "vats_lizard_multi_target_70",
+    62: "phone_wheel_70",
+    63: "phone_windscreen_70",
     70: "microsleep_70",
     71: "sleep_70",
 } | {row: look.scenario for row, look in DRIVING_TASK_ROWS.items()}

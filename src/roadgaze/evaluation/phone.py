@@ -5,10 +5,12 @@ and the figures leaving drivers out (`roadgaze eval DATASET --task phone`,
 A data set is a folder with `ground_truth.csv` (`file,phone_use` and optional `class`,
 `subject`). Each image goes through the hand stage and the face landmarker as stills (the
 configured models), then `roadgaze.phone.features.frame_vector`: the very vector the service
-judges. Leaving drivers out: the classifier is refitted on all drivers but one and scores that
-one's images; the threshold is the score that keeps the false-positive rate over all negatives
-at `TARGET_FPR`, read from those held-out scores (so it is chosen without the driver it is
-applied to only in the sense that every driver's scores are out-of-fold).
+judges; an image is phone use when its score reaches the threshold or a hand is held up in front
+(`roadgaze.phone.held_up`), as the service judges it. Leaving drivers out: the classifier is
+refitted on all drivers but one and scores that one's images; the threshold is the score that
+keeps the false-positive rate over all negatives at `TARGET_FPR`, read from those held-out
+scores (so it is chosen without the driver it is applied to only in the sense that every
+driver's scores are out-of-fold).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import numpy.typing as npt
 
 from roadgaze.errors import DatasetError, SourceError
 from roadgaze.phone.boosting import BoostSettings, fit, predict
+from roadgaze.phone.held_up import held_up_rows
 
 TARGET_FPR = 0.10
 CLASS_NAMES = {
@@ -198,6 +201,10 @@ class PhoneReport:
     per_driver_fpr: dict[str, float]
     images: int
     judged: float
+    held_up: int = 0
+    """Images judged phone use by the held-up rule (`roadgaze.phone.held_up`)."""
+    held_up_negatives: int = 0
+    """Of those, images that are not phone use."""
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -207,7 +214,8 @@ def score_report(
     """The figures of `scores` at `threshold`; an image that cannot be judged counts as not
     phone use (what the service says for it is 'unknown')."""
     y, classes, groups = features.labels, features.classes, features.groups
-    positive = np.nan_to_num(scores, nan=-1.0) >= threshold
+    held = held_up_rows(features.x)
+    positive = (np.nan_to_num(scores, nan=-1.0) >= threshold) | held
     positive &= features.judged
 
     def rate(mask: npt.NDArray[np.bool_]) -> float:
@@ -222,6 +230,8 @@ def score_report(
         per_driver_fpr={d: rate((groups == d) & (y == 0)) for d in sorted(set(groups)) if d},
         images=len(y),
         judged=float(features.judged.mean()),
+        held_up=int(held.sum()),
+        held_up_negatives=int((held & (y == 0)).sum()),
     )
 
 
@@ -231,6 +241,8 @@ def format_report(title: str, report: PhoneReport) -> str:
         f"{title}: {report.images} images, judged {report.judged:.1%}, threshold "
         f"{report.threshold:.3f}",
         f"  phone use recall {report.recall:.3f}, false-positive rate {report.fpr:.3f}",
+        f"  held up in front (roadgaze's rule): {report.held_up} images, "
+        f"{report.held_up_negatives} of them not phone use",
     ]
     for label, value in report.per_class.items():
         kind = "recall" if label in {"c1", "c2", "c3", "c4"} else "FPR"
@@ -258,4 +270,6 @@ def report_json(report: PhoneReport) -> dict[str, Any]:
         "per_driver_fpr": report.per_driver_fpr,
         "images": report.images,
         "judged": report.judged,
+        "held_up": report.held_up,
+        "held_up_negatives": report.held_up_negatives,
     }

@@ -6,7 +6,9 @@ scores higher) and where it is held: at the `ear` (within `EAR_FACE_WIDTHS` face
 face's centre), in the `lap` (its centre in the image's lowest `LAP_IMAGE_FRACTION`, a camera in
 front of the driver seeing the lap at the bottom) or `held_up` (in front, above the lap). Without
 hands, a face and a body it cannot judge (`phone_use` None); judged from the body alone, the
-hand and the place are not named.
+hand and the place are not named. A hand held up in front of a camera that faces the driver
+(`roadgaze.phone.held_up`, roadgaze's own rule) is phone use `held_up` whatever the score: the
+classifier learnt from a camera at the side.
 """
 
 from __future__ import annotations
@@ -15,7 +17,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from roadgaze.phone.features import Body, FaceBox, frame_vector
+from roadgaze.phone.features import Body, FaceBox, frame_vector, slots
+from roadgaze.phone.held_up import held_up_slots
 from roadgaze.phone.model import PhoneModel
 from roadgaze.types import FaceFeatures, Hand, PhoneJudgement, PhonePose
 
@@ -75,7 +78,14 @@ def judge_box(
     if not hands and box is None and body is None:
         return PhoneJudgement(phone_use=None, score=None)
     cut = model.threshold if threshold is None else threshold
-    score = model.score(frame_vector(hands, box, size, head_deg, body))
+    vector = frame_vector(hands, box, size, head_deg, body)
+    score = model.score(vector)
+    raised = held_up_slots(vector)
+    if raised and score < cut:
+        left, right = slots(hands)
+        holder = left if raised[0] == "left" else right
+        side = None if holder is None else holder.side
+        return PhoneJudgement(phone_use=True, score=score, hand=side, pose=PhonePose.HELD_UP)
     if score < cut or not hands:
         return PhoneJudgement(phone_use=score >= cut, score=score)
     holder = max(

@@ -72,3 +72,16 @@ def region_alpha(
     if feather_px > 0:
         return np.asarray(cv2.GaussianBlur(alpha, (0, 0), feather_px), dtype=np.float32)
     return alpha
+
+
+def out_of_focus(
+    colour: npt.NDArray[np.float32], alpha: npt.NDArray[np.float32], blur_px: float
+) -> Layer:
+    """A layer painted sharp (`colour`, `alpha`) seen out of focus: colour and alpha spread by a
+    Gaussian of `blur_px`, the colour weighted by the alpha (no dark fringe at the edges)."""
+    import cv2
+
+    spread = np.asarray(cv2.GaussianBlur(colour * alpha[..., None], (0, 0), blur_px))
+    soft = np.asarray(cv2.GaussianBlur(alpha, (0, 0), blur_px))[..., None]
+    shown = np.where(soft > 1e-3, spread / np.maximum(soft, 1e-3), 0.0)
+    return Layer(shown.astype(np.float32), soft[..., 0].astype(np.float32))

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from roadgaze.synth.layers import Layer
+from roadgaze.synth.layers import Layer, out_of_focus
 from roadgaze.synth.renderer import FaceRenderer, ImageBGR
 from roadgaze.types import FloatArray
 
@@ -63,7 +63,8 @@ PLACEMENTS: dict[str, HandPlacement | None] = {
 right-hand-drive cabin."""
 
 
-def _skin(renderer: FaceRenderer) -> FloatArray:
+def skin_bgr(renderer: FaceRenderer) -> FloatArray:
+    """The face's skin colour (BGR): the median of two cheek patches of the photo."""
     points = renderer.mesh.points_px
     half = max(2, round(0.03 * renderer.mesh.face_width_px))
     patches = [
@@ -110,7 +111,7 @@ def hand_layer(
     centre = eyes + np.array([mirror * placement.across_w, placement.below_eyes_w]) * width
     forearm = np.array([mirror * placement.forearm[0], placement.forearm[1]])
     forearm /= np.linalg.norm(forearm)
-    skin = _skin(renderer).astype(np.float32)
+    skin = skin_bgr(renderer).astype(np.float32)
     columns, height = renderer.size
     colour = np.zeros((height, columns, 3), dtype=np.float32)
     alpha = np.zeros((height, columns), dtype=np.float32)
@@ -160,8 +161,4 @@ def hand_layer(
         x = left + 2 * index * knuckle
         line = np.round(np.array([[x, top], [x, top + 1.2 * half_h]]) * 16).astype(np.int32)
         cv2.polylines(colour, [line], False, crease, 1, cv2.LINE_AA, 4)
-    blur = max(0.5, BLUR_W * width)
-    spread = np.asarray(cv2.GaussianBlur(colour * alpha[..., None], (0, 0), blur))
-    soft = np.asarray(cv2.GaussianBlur(alpha, (0, 0), blur))[..., None]
-    shown = np.where(soft > 1e-3, spread / np.maximum(soft, 1e-3), 0.0)
-    return Layer(shown.astype(np.float32), soft[..., 0].astype(np.float32))
+    return out_of_focus(colour, alpha, max(0.5, BLUR_W * width))

@@ -7,9 +7,15 @@ its speed) gives a requirement that no alert comes at all.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+import numpy as np
+
 from roadgaze.config import MonitorConfig
-from roadgaze.conformance.model import Requirement
+from roadgaze.conformance.model import Requirement, Segment
 from roadgaze.monitor.protocols import Rule, Trigger, addw, distraction_trigger, euroncap, uses
+from roadgaze.monitor.zones import ROAD, ZoneMap
+from roadgaze.synth.timeline import Keyframe, Timeline
 
 LATENCY_S = 0.6
 """How much later than the rule's time a warning may come, measured from the start of the look:
@@ -23,6 +29,8 @@ as early (a warning that early would also come on glances the protocol lets pass
 TIMER_EARLY_S = 0.5
 """The same for timers that start at a sharp event (eyes closing, the lens covered, the face
 gone, the frames frozen)."""
+PATH_STEP_S = 1.0 / 150.0
+"""The step at which `off_road_reached_s` follows the rendered head (ten per 15 fps frame)."""
 BELOW_TRIGGER_S = 0.75
 """A glance "just below" a trigger lasts this much less than the trigger time (the turn in and
 out adds about as much off-road time as it takes: the glance's off-road time is its duration)."""
@@ -97,3 +105,60 @@ def timer(
     expected_s = value + offset_s
     window = (expected_s - TIMER_EARLY_S, expected_s + LATENCY_S)
     return Requirement(key, text, source_of(rule), kinds, window, from_label, applies(config, rule))
+
+
+def off_road_reached_s(
+    config: MonitorConfig, segments: Sequence[Segment], from_label: str, total_s: float
+) -> float | None:
+    """When, after the labelled segment starts, the rendered head has been off the road
+    `total_s` in all (None: never): its eased path (`roadgaze.synth.timeline`) classified
+    through the configured zones (`ZoneMap`, with its hysteresis) every `PATH_STEP_S`.
+
+    The expected time of a glance-counting rule (VATS): a glance's off-road time is not its
+    segment's length but the time the head spends beyond the road's edge, turn in and out
+    included, which the target's distance from that edge sets (a far target leaves the road early
+    in the turn and comes back late). For looks that move the head only: the eyes' share of a
+    lizard look passes the gaze's calibration and dead band first."""
+    timeline = Timeline(tuple(Keyframe(s.yaw_deg, s.pitch_deg, s.duration_s) for s in segments))
+    start_s = 0.0
+    for segment in segments:
+        if segment.label == from_label:
+            break
+        start_s += segment.duration_s
+    t = np.arange(0.0, timeline.duration_s, PATH_STEP_S)
+    yaw, pitch = timeline.pose_at(t)
+    zones = ZoneMap.from_config(config)
+    zone: str | None = None
+    off_s = 0.0
+    for t_s, yaw_deg, pitch_deg in zip(t, yaw, pitch, strict=True):
+        zone = zones.classify(float(yaw_deg), float(pitch_deg), zone)
+        if zone != ROAD:
+            off_s += PATH_STEP_S
+            if off_s >= total_s - 1e-9:
+                return float(t_s) - start_s
+    return None
+
+
+def vats(
+    config: MonitorConfig,
+    key: str,
+    text: str,
+    segments: Sequence[Segment],
+    nominal_offset_s: float,
+    from_label: str = "look",
+) -> Requirement:
+    """VATS within the measurement's margins of when the glances' off-road time reaches its
+    threshold: the rendered head's (`off_road_reached_s`) for glances of the head alone; for
+    glances that move the eyes, each glance's off-road time taken as its length, plus
+    `nominal_offset_s` (the road between the glances)."""
+    rule = euroncap.VATS
+    threshold_s = rule.value(config)
+    if threshold_s is None:
+        raise ValueError(f"rule {rule.key}: {rule.config_key} is not set")
+    eyes_move = any((s.eye_yaw_deg, s.eye_pitch_deg) != (0.0, 0.0) for s in segments)
+    reached_s = None if eyes_move else off_road_reached_s(config, segments, from_label, threshold_s)
+    expected_s = threshold_s + nominal_offset_s if reached_s is None else reached_s
+    window = (expected_s - TIMER_EARLY_S, expected_s + LATENCY_S)
+    return Requirement(
+        key, text, source_of(rule), ("vats",), window, from_label, applies(config, rule)
+    )

@@ -109,14 +109,8 @@ def _short(
         glances.append(Segment(VATS_ROAD_S))
     places = " and ".join(t.replace("_", " ") for t in targets)
     what = f"{count} {movement} glances of {VATS_GLANCE_S:g} s at the {places} at 70 km/h"
-    warns = expect.timer(
-        config,
-        euroncap.VATS,
-        ("vats",),
-        f"{scenario}.warns",
-        what,
-        "look",
-        (count - 1) * VATS_ROAD_S,
+    warns = expect.vats(
+        config, f"{scenario}.warns", what, (ahead(), *glances, back()), (count - 1) * VATS_ROAD_S
     )
     short = expect.no_distraction(
         config,

@@ -33,15 +33,13 @@ def vats_scenarios(config: MonitorConfig) -> list[Scenario]:
     for index in range(count):
         glances.append(look(target, VATS_GLANCE_S, "look" if index == 0 else f"glance{index}"))
         glances.append(Segment(VATS_ROAD_S))
-    # The off-road time reaches the threshold in the last glance: the earlier glances' time
-    # plus the road between them after the first glance starts.
-    warns = expect.timer(
+    # The off-road time reaches the threshold in the last glance: when the rendered head's time
+    # beyond the road's edge adds up to it (expect.vats).
+    warns = expect.vats(
         config,
-        euroncap.VATS,
-        ("vats",),
         "vats_70.warns",
         f"{count} glances of {VATS_GLANCE_S:g} s at the centre stack at 70 km/h",
-        "look",
+        (ahead(), *glances, back()),
         (count - 1) * VATS_ROAD_S,
     )
     text = f"{count - 1} glances of {VATS_GLANCE_S:g} s within {config.vats_window_s:g} s: no VATS"

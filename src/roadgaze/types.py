@@ -101,9 +101,8 @@ class FaceFeatures:
     (`roadgaze.landmarks.eye_contrast.eye_sharpness`; NaN where too small); None when not
     measured. Low: motion blur or glare, lids that read closed cannot be judged."""
     eye_lid_share: tuple[float, float] | None = None
-    """The share of the edge energy around the (right, left) eye running along it
-    (`roadgaze.landmarks.eye_contrast.eye_lid_share`; NaN where too small or flat); None when
-    not measured. Low in both eyes: strands across them (a hair fringe)."""
+    """The share of the edge energy around the (right, left) eye running along it (`roadgaze.
+    landmarks.eye_contrast.eye_lid_share`; NaN: too small, flat). Low in both: a fringe."""
 
 
 @dataclass(frozen=True, slots=True)

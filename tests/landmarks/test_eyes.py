@@ -267,6 +267,8 @@ def test_edges_across_both_eyes_are_eyes_hidden_by_strands() -> None:
     assert hidden.occluded and hidden.occluded_by == "strands" and not hidden.gaze_available
     assert not eye_features(points, 0.0, lid_share=(0.1, 0.5)).occluded  # one eye is seen
     assert not eye_features(points, 0.0, lid_share=(math.nan, math.nan)).occluded
+    # One eye measured (the other too small): a glasses rim beside it may read as low.
+    assert not eye_features(points, 0.0, lid_share=(0.26, math.nan)).occluded
     lens = eye_features(points, 0.0, contrast=(0.02, 0.05), lid_share=(0.1, 0.1))
     assert lens.occluded and lens.occluded_by == ""  # a flat opening: the lens says it first
     off = EyesConfig(min_lid_share=0.0)

@@ -351,8 +351,8 @@ def _occluded(
     config: EyesConfig,
 ) -> str | None:
     """What hides the eyes: '' for a flat opening in both measured eyes although the lids look
-    open (a dark lens), `strands` for edges mostly across both measured eyes (hair), None when
-    nothing does."""
+    open (a dark lens), `strands` for edges mostly across both eyes, both measured (hair: one
+    eye alone may be a glasses rim or a lock beside it), None when nothing does."""
     measured = [
         (openness[side], value)
         for side, value in contrasts.items()
@@ -368,7 +368,7 @@ def _occluded(
     ):
         return ""
     shares = [value for value in lid_share or () if math.isfinite(value)]
-    if config.min_lid_share > 0 and shares and max(shares) < config.min_lid_share:
+    if config.min_lid_share > 0 and len(shares) == 2 and max(shares) < config.min_lid_share:
         return "strands"
     return None
 

@@ -83,6 +83,9 @@ class EyesFeatures:
     """Why the eyes are unavailable for gaze ('' when at least one eye gives a direction)."""
     occluded: bool = False
     """The image check says the eyes cannot be seen (sunglasses, glare, a hand)."""
+    occluded_by: str = ""
+    """What hides them, when `occluded` and not a flat opening (a dark lens): `strands` (edges
+    across both eyes: a hair fringe) or `hand` (a hand found in front of both eyes)."""
     blurred: bool = False
     """The image check finds no sharp edges around the measured eyes (motion blur, glare): lids
     that read closed cannot be judged."""

@@ -100,6 +100,9 @@ class FaceFeatures:
     """Edge strength around the (right, left) eye relative to the skin below it
     (`roadgaze.landmarks.eye_contrast.eye_sharpness`; NaN where too small); None when not
     measured. Low: motion blur or glare, lids that read closed cannot be judged."""
+    eye_lid_share: tuple[float, float] | None = None
+    """The share of the edge energy around the (right, left) eye running along it (`roadgaze.
+    landmarks.eye_contrast.eye_lid_share`; NaN: too small, flat). Low in both: a fringe."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -10,7 +10,13 @@ import pytest
 
 from repo_paths import POINTING04
 from roadgaze.config import EyesConfig
-from roadgaze.landmarks.eye_contrast import eye_contrast, eye_sharpness, polygon_mask
+from roadgaze.landmarks.eye_contrast import (
+    eye_checks,
+    eye_contrast,
+    eye_lid_share,
+    eye_sharpness,
+    polygon_mask,
+)
 from roadgaze.landmarks.eyes import (
     BLENDSHAPE_PITCH_PER_DEG,
     BLENDSHAPE_YAW_PER_DEG,
@@ -235,6 +241,38 @@ def test_eye_sharpness_of_a_drawn_eye_blurred_and_flat() -> None:
     assert eye_sharpness(blurred, points, RIGHT_EYE) < EyesConfig().min_sharpness < sharp
     assert eye_sharpness(np.full((480, 640), 150, np.uint8), points, LEFT_EYE) == 0.0
     assert math.isnan(eye_sharpness(image[:10, :10], points, LEFT_EYE))
+
+
+def test_lid_share_reads_lids_along_the_eye_and_strands_across_it() -> None:
+    points = built_landmarks(aperture=0.4)
+    image = np.full((480, 640), 150, np.uint8)  # skin
+    for eye in EYES:
+        image[polygon_mask(points[list(eye.contour), :2], (480, 640))] = 230
+    seen = eye_lid_share(image, points, RIGHT_EYE)
+    strands = image.copy()
+    strands[:, ::4] = 60  # dark hair every 4 px, hanging down across the eyes
+    assert seen > 0.5 > EyesConfig().min_lid_share > eye_lid_share(strands, points, LEFT_EYE)
+    # The share follows the eye's own axis: the same eye and image turned 90 deg read alike.
+    turned = np.ascontiguousarray(np.rot90(image))
+    points_turned = points.copy()
+    points_turned[:, 0], points_turned[:, 1] = points[:, 1], 640 - points[:, 0]
+    assert eye_lid_share(turned, points_turned, RIGHT_EYE) == pytest.approx(seen, abs=0.05)
+    assert eye_checks(image, points, RIGHT_EYE)[2] == seen
+    assert math.isnan(eye_lid_share(np.full((480, 640), 150, np.uint8), points, LEFT_EYE))
+
+
+def test_edges_across_both_eyes_are_eyes_hidden_by_strands() -> None:
+    points = built_landmarks(aperture=0.3)
+    hidden = eye_features(points, 0.0, lid_share=(0.1, 0.15))
+    assert hidden.occluded and hidden.occluded_by == "strands" and not hidden.gaze_available
+    assert not eye_features(points, 0.0, lid_share=(0.1, 0.5)).occluded  # one eye is seen
+    assert not eye_features(points, 0.0, lid_share=(math.nan, math.nan)).occluded
+    # One eye measured (the other too small): a glasses rim beside it may read as low.
+    assert not eye_features(points, 0.0, lid_share=(0.26, math.nan)).occluded
+    lens = eye_features(points, 0.0, contrast=(0.02, 0.05), lid_share=(0.1, 0.1))
+    assert lens.occluded and lens.occluded_by == ""  # a flat opening: the lens says it first
+    off = EyesConfig(min_lid_share=0.0)
+    assert not eye_features(points, 0.0, lid_share=(0.0, 0.0), config=off).occluded
 
 
 def test_eyes_without_sharp_edges_are_blurred() -> None:

@@ -124,6 +124,11 @@ def test_unavailable_eyes_and_the_baseline_scaling() -> None:
         EyeStatus.UNAVAILABLE,
         "eyes hidden",
     )
+    # A fist read as shut lids: hidden by a hand, never closed (no microsleep from a hand).
+    fist = replace(eyes_of(0.02, 0.9, occluded=True), occluded_by="hand")
+    assert classify_eyes(CONFIG, fist, 0.0) == (EyeStatus.UNAVAILABLE, "eyes hidden by a hand")
+    fringe = replace(eyes_of(occluded=True), occluded_by="strands")
+    assert classify_eyes(CONFIG, fringe, 0.0)[1] == "eyes hidden by strands across them"
     # A driver whose open eyes read 0.39 (x1.3): 0.12 is closed for them even with a low blink.
     assert classify_eyes(CONFIG, eyes_of(0.12, 0.1), 0.0, open_baseline=0.39)[0] is (
         EyeStatus.CLOSED

@@ -39,6 +39,11 @@ class EyesConfig(Section):
     lids look open are taken as hidden (sunglasses); 0 turns the image check off."""
     occluded_min_openness: float = Field(default=0.18, ge=0)
     """The lids look open (so low contrast means a lens, not a closed lid) above this openness."""
+    min_lid_share: float = Field(default=0.3, ge=0, le=1)
+    """Eyes whose surroundings show less than this share of their edge energy running along the
+    eye (the lids, the crease, the brow), in both eyes (both measured), are taken as hidden:
+    strands across them (a hair fringe). Seen eyes read 0.42 or more in at least one eye on
+    every real face measured, a rendered fringe 0.16 or less (docs/eyes.md); 0: off."""
     min_sharpness: float = Field(default=0.65, ge=0)
     """Eyes whose surroundings show weaker edges than this (relative to the skin below) in every
     measured eye are blurred: lids that read closed there are not judged (unavailable, never

@@ -118,6 +118,7 @@ def unmirror(face: FaceFeatures, image_width_px: int) -> FaceFeatures:
         blendshapes=None if face.blendshapes is None else swap_sides(face.blendshapes),
         eye_contrast=None if face.eye_contrast is None else face.eye_contrast[::-1],
         eye_sharpness=None if face.eye_sharpness is None else face.eye_sharpness[::-1],
+        eye_lid_share=None if face.eye_lid_share is None else face.eye_lid_share[::-1],
     )
 
 
@@ -168,6 +169,7 @@ def merge_mirrored(
                 blendshapes=_mean_scores(face.blendshapes, other.blendshapes),
                 eye_contrast=face.eye_contrast,
                 eye_sharpness=face.eye_sharpness,
+                eye_lid_share=face.eye_lid_share,
             )
         )
     return merged + candidates

@@ -5,8 +5,10 @@ relative to the skin just below the eye, so it does not depend on the exposure. 
 looking open, a flat opening in both eyes means the eyes are hidden (`EyesConfig.min_contrast`).
 The lids are sharp edges in a focused image; motion blur, glare and a washed-out picture soften
 them, and MediaPipe then draws the lids nearly shut over open eyes: lids that read closed on eyes
-without edges cannot be judged (`EyesConfig.min_sharpness`). The evidence and its limits:
-docs/eyes.md.
+without edges cannot be judged (`EyesConfig.min_sharpness`). An eye's edges run mostly along it
+(the lids, the lid crease, the brow), open or closed; hair hanging over it (a fringe) runs across
+it: edges mostly across the eye in both eyes mean the eyes are hidden
+(`EyesConfig.min_lid_share`). The evidence and its limits: docs/eyes.md.
 """
 
 from __future__ import annotations
@@ -68,6 +70,8 @@ class _Outline:
     """Its maximum x and y."""
     lower_lid_y: float
     """The lowest y of the lower lid (the skin band is measured from it)."""
+    axis: tuple[float, float]
+    """The unit vector from the inner to the outer corner (along the lids)."""
 
 
 def _outline(landmarks_px: npt.ArrayLike, eye: EyeIndices) -> _Outline:
@@ -81,12 +85,15 @@ def _outline(landmarks_px: npt.ArrayLike, eye: EyeIndices) -> _Outline:
     polygon = points[:-2]
     corners = points[-2] - points[-1]
     low, high = polygon.min(axis=0), polygon.max(axis=0)
+    width_px = math.sqrt(corners.dot(corners))  # np.linalg.norm's arithmetic, without its checks
+    along = corners / width_px if width_px > 0 else np.array([1.0, 0.0])
     return _Outline(
         polygon=polygon,
-        width_px=math.sqrt(corners.dot(corners)),  # np.linalg.norm's arithmetic, without its checks
+        width_px=width_px,
         low=(float(low[0]), float(low[1])),
         high=(float(high[0]), float(high[1])),
         lower_lid_y=float(polygon[9:, 1].max()),
+        axis=(float(along[0]), float(along[1])),
     )
 
 
@@ -108,16 +115,29 @@ def eye_sharpness(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndi
     under strong motion blur or glare (docs/eyes.md). NaN when the eye is narrower than
     `MIN_EYE_WIDTH_PX` or off the image.
     """
-    return _sharpness(np.asarray(gray), _outline(landmarks_px, eye))
+    return _edges(np.asarray(gray), _outline(landmarks_px, eye))[0]
+
+
+def eye_lid_share(gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndices) -> float:
+    """How much of the edge energy around one eye runs along it: the share of the squared
+    gradient (3x3 Sobel, in the box of `eye_sharpness`) that points across the eye's corner
+    line, i.e. comes from edges parallel to it (the lids, the crease, the brow). Head roll does
+    not change it. About 0.5-0.9 on seen eyes, open or closed; about 0.1 with hair strands
+    hanging across them (docs/eyes.md). NaN when the eye is narrower than `MIN_EYE_WIDTH_PX`,
+    off the image, or the box is flat.
+    """
+    return _edges(np.asarray(gray), _outline(landmarks_px, eye))[1]
 
 
 def eye_checks(
     gray: npt.ArrayLike, landmarks_px: npt.ArrayLike, eye: EyeIndices
-) -> tuple[float, float]:
-    """(`eye_contrast`, `eye_sharpness`) of one eye, its outline measured once."""
+) -> tuple[float, float, float]:
+    """(`eye_contrast`, `eye_sharpness`, `eye_lid_share`) of one eye, its outline measured
+    once."""
     image: npt.NDArray[Any] = np.asarray(gray)
     outline = _outline(landmarks_px, eye)
-    return _contrast(image, outline), _sharpness(image, outline)
+    sharpness, lid_share = _edges(image, outline)
+    return _contrast(image, outline), sharpness, lid_share
 
 
 def _contrast(image: npt.NDArray[Any], outline: _Outline) -> float:
@@ -199,7 +219,8 @@ def _median(values: npt.NDArray[Any]) -> float:
     return (int(flat[middle - 1]) + int(flat[middle])) / 2
 
 
-def _sharpness(image: npt.NDArray[Any], outline: _Outline) -> float:
+def _edges(image: npt.NDArray[Any], outline: _Outline) -> tuple[float, float]:
+    """(sharpness, lid share) of the eye's box: one Sobel pass for both."""
     import cv2
 
     pad = 0.15 * outline.width_px
@@ -208,15 +229,28 @@ def _sharpness(image: npt.NDArray[Any], outline: _Outline) -> float:
     y0 = max(0, math.floor(outline.low[1] - pad))
     y1 = min(image.shape[0], math.ceil(outline.high[1] + pad) + 1)
     if x1 - x0 < 4 or y1 - y0 < 4 or outline.width_px < MIN_EYE_WIDTH_PX:
-        return math.nan
+        return math.nan, math.nan
     crop = image[y0:y1, x0:x1]
     if crop.dtype != np.uint8:
         # A uint8 crop goes to Sobel as it is: its sums are small integers, exact in float32.
         crop = crop.astype(np.float32)
-    magnitude = cv2.magnitude(
-        cv2.Sobel(crop, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(crop, cv2.CV_32F, 0, 1, ksize=3)
-    ).ravel()
+    gx = cv2.Sobel(crop, cv2.CV_32F, 1, 0, ksize=3)
+    gy = cv2.Sobel(crop, cv2.CV_32F, 0, 1, ksize=3)
+    magnitude = cv2.magnitude(gx, gy).ravel()
     rank = int(0.9 * (magnitude.size - 1))  # the 90th percentile, lower value (no interpolation)
     magnitude.partition(rank)
     edge = float(magnitude[rank])
-    return edge / _skin_reference(image, outline, x0, x1)
+    return edge / _skin_reference(image, outline, x0, x1), _lid_share(gx, gy, outline.axis)
+
+
+def _lid_share(gx: npt.NDArray[Any], gy: npt.NDArray[Any], axis: tuple[float, float]) -> float:
+    """The share of the squared gradient across `axis` (edges running along it): with the unit
+    normal n = (-ay, ax), sum((g . n)^2) / sum(|g|^2), from the three sums of the structure
+    tensor. NaN for a flat box."""
+    xx, yy = float(np.dot(gx.ravel(), gx.ravel())), float(np.dot(gy.ravel(), gy.ravel()))
+    total = xx + yy
+    if total <= 0:
+        return math.nan
+    xy = float(np.dot(gx.ravel(), gy.ravel()))
+    ax, ay = axis
+    return (ay * ay * xx + ax * ax * yy - 2.0 * ax * ay * xy) / total

@@ -16,8 +16,9 @@ their evidence: docs/eyes.md):
   the corner midpoint, orthographic camera) is computed beside it as a diagnostic.
 - **Usable eyes.** No eye without a head yaw, beyond `max_head_yaw_deg`, below
   `min_eye_width_px`, at landmark quality under `min_quality`, or when the image check finds the
-  eyes hidden (sunglasses). Beyond `far_eye_max_yaw_deg`, or narrower than
-  `far_eye_min_width_ratio` of the other, the far eye is dropped. The nearer eye's openness is
+  eyes hidden (a dark lens: a flat opening; hair: edges across both eyes). Beyond
+  `far_eye_max_yaw_deg`, or narrower than `far_eye_min_width_ratio` of the other, the far eye is
+  dropped. The nearer eye's openness is
   still judged up to `closure_max_head_yaw_deg`.
 
 Sign convention: image x right, y down; yaw > 0 toward the person's own left (the iris moves to
@@ -207,6 +208,7 @@ def eye_features(
     contrast: tuple[float, float] | None = None,
     config: EyesConfig | None = None,
     sharpness: tuple[float, float] | None = None,
+    lid_share: tuple[float, float] | None = None,
 ) -> EyesFeatures:
     """Openness, direction and usability of both eyes of one face.
 
@@ -214,7 +216,8 @@ def eye_features(
     yaw (None when unknown: no eye gives a direction). `head_pitch_deg`: MediaPipe's matrix pitch
     (0 when None), used by the iris model only. `blendshapes`: the 52 scores by name (None: the
     direction falls back to the iris model, and there is no blink score). `contrast`: (right,
-    left) from `eye_contrast`, `sharpness` likewise from `eye_sharpness`. Raises ValueError for
+    left) from `eye_contrast`, `sharpness` likewise from `eye_sharpness`, `lid_share` from
+    `eye_lid_share`. Raises ValueError for
     a wrong shape or non-finite landmarks.
     """
     config = config if config is not None else EyesConfig()
@@ -238,7 +241,8 @@ def eye_features(
         if contrast is None
         else dict(zip(("right", "left"), contrast, strict=True))
     )
-    occluded = _occluded(openness, contrasts, config)
+    occluded_by = _occluded(openness, contrasts, lid_share, config)
+    occluded = occluded_by is not None
     blurred = _blurred(sharpness, config)
     gaze_face = _face_reason(yaw, scale, quality, occluded, config.max_head_yaw_deg, config)
     closure_face = _face_reason(
@@ -301,6 +305,7 @@ def eye_features(
         scale_px=scale,
         reason=reason,
         occluded=occluded,
+        occluded_by=occluded_by or "",
         blurred=blurred,
     )
 
@@ -322,6 +327,7 @@ def driver_eyes(
             face.eye_contrast,
             config,
             face.eye_sharpness,
+            face.eye_lid_share,
         )
     except ValueError:
         return None
@@ -339,20 +345,32 @@ def _look_down(blendshapes: Mapping[str, float] | None, eye: EyeIndices) -> floa
 
 
 def _occluded(
-    openness: Mapping[str, float], contrasts: Mapping[str, float | None], config: EyesConfig
-) -> bool:
-    """Both measured eyes show a flat opening although the lids look open (a dark lens)."""
-    if config.min_contrast <= 0:
-        return False
+    openness: Mapping[str, float],
+    contrasts: Mapping[str, float | None],
+    lid_share: tuple[float, float] | None,
+    config: EyesConfig,
+) -> str | None:
+    """What hides the eyes: '' for a flat opening in both measured eyes although the lids look
+    open (a dark lens), `strands` for edges mostly across both eyes, both measured (hair: one
+    eye alone may be a glasses rim or a lock beside it), None when nothing does."""
     measured = [
         (openness[side], value)
         for side, value in contrasts.items()
         if value is not None and math.isfinite(value)
     ]
-    return bool(measured) and all(
-        value < config.min_contrast and open_value >= config.occluded_min_openness
-        for open_value, value in measured
-    )
+    if (
+        config.min_contrast > 0
+        and measured
+        and all(
+            value < config.min_contrast and open_value >= config.occluded_min_openness
+            for open_value, value in measured
+        )
+    ):
+        return ""
+    shares = [value for value in lid_share or () if math.isfinite(value)]
+    if config.min_lid_share > 0 and len(shares) == 2 and max(shares) < config.min_lid_share:
+        return "strands"
+    return None
 
 
 def _blurred(sharpness: tuple[float, float] | None, config: EyesConfig) -> bool:

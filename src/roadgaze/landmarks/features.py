@@ -206,15 +206,16 @@ def features_from_landmarks(
     blendshapes: Mapping[str, float] | None = None,
     eye_contrast: tuple[float, float] | None = None,
     eye_sharpness: tuple[float, float] | None = None,
+    eye_lid_share: tuple[float, float] | None = None,
 ) -> FaceFeatures:
     """The yaw models' inputs for one face from its (478, 3) landmarks in pixels (numpy only).
 
     `image_size_px` (width, height) enables the edge term of `quality`; `transformation_matrix`
     (MediaPipe's 4x4) fills `mediapipe_yaw_deg` / `mediapipe_pitch_deg`; the mid-line's `y_top_px`,
-    `y_bottom_px` and `y_center_px` are always filled. `blendshapes`, `eye_contrast` and
-    `eye_sharpness` are measured elsewhere and passed through into the record (built once: a
-    `dataclasses.replace` afterwards would cost as much again). Raises ValueError for a wrong shape
-    or non-finite landmarks.
+    `y_bottom_px` and `y_center_px` are always filled. `blendshapes`, `eye_contrast`,
+    `eye_sharpness` and `eye_lid_share` are measured elsewhere and passed through into the record
+    (built once: a `dataclasses.replace` afterwards would cost as much again). Raises ValueError
+    for a wrong shape or non-finite landmarks.
     """
     points = np.asarray(landmarks_px, dtype=np.float32)
     if points.ndim != 2 or points.shape[0] != NUM_LANDMARKS or points.shape[1] not in (2, 3):
@@ -247,4 +248,5 @@ def features_from_landmarks(
         blendshapes=blendshapes,
         eye_contrast=eye_contrast,
         eye_sharpness=eye_sharpness,
+        eye_lid_share=eye_lid_share,
     )

@@ -365,8 +365,8 @@ class Landmarker(ClosesOnExit):
         faces: list[FaceFeatures] = []
         for face in found:
             pixels = face.landmarks_px
-            right_contrast, right_sharpness = eye_checks(gray, pixels, RIGHT_EYE)
-            left_contrast, left_sharpness = eye_checks(gray, pixels, LEFT_EYE)
+            right_contrast, right_sharpness, right_lids = eye_checks(gray, pixels, RIGHT_EYE)
+            left_contrast, left_sharpness, left_lids = eye_checks(gray, pixels, LEFT_EYE)
             matrix, blendshapes = face.outputs()
             faces.append(
                 features_from_landmarks(
@@ -377,6 +377,7 @@ class Landmarker(ClosesOnExit):
                     blendshapes=blendshapes,
                     eye_contrast=(right_contrast, left_contrast),
                     eye_sharpness=(right_sharpness, left_sharpness),
+                    eye_lid_share=(right_lids, left_lids),
                 )
             )
         return faces

@@ -12,7 +12,15 @@ from roadgaze.config import MonitorConfig
 from roadgaze.monitor.zones import Zone, ZoneMap
 from roadgaze.types import EyesFeatures, EyeStatus
 
-__all__ = ["POPULATION_OPEN", "classify_eyes", "eye_zone_map", "gaze_deg", "soft_threshold"]
+__all__ = [
+    "HIDDEN",
+    "POPULATION_OPEN",
+    "classify_eyes",
+    "eye_zone_map",
+    "gaze_deg",
+    "hidden_reason",
+    "soft_threshold",
+]
 
 POPULATION_OPEN = 0.30
 """The open-eye openness the thresholds are set for (Pointing'04 median 0.31)."""
@@ -42,6 +50,18 @@ def gaze_deg(
     return yaw, pitch, True
 
 
+HIDDEN = "eyes hidden"
+"""The start of every reason of eyes hidden (`hidden_reason`)."""
+_HIDDEN_BY = {"strands": "by strands across them", "hand": "by a hand"}
+
+
+def hidden_reason(eyes: EyesFeatures) -> str:
+    """`eyes hidden` (a flat opening: a dark lens), or with what hides them: `eyes hidden by
+    strands across them` (hair), `eyes hidden by a hand`."""
+    by = _HIDDEN_BY.get(eyes.occluded_by, eyes.occluded_by)
+    return f"{HIDDEN} {by}" if by else HIDDEN
+
+
 def classify_eyes(
     config: MonitorConfig,
     eyes: EyesFeatures | None,
@@ -58,7 +78,7 @@ def classify_eyes(
     if eyes is None:
         return EyeStatus.UNAVAILABLE, "no eyes measured"
     if eyes.occluded:
-        return EyeStatus.UNAVAILABLE, "eyes hidden"
+        return EyeStatus.UNAVAILABLE, hidden_reason(eyes)
     openness, blink = eyes.openness, eyes.blink
     if openness is None:
         reasons = [e.reason for e in (eyes.right, eyes.left) if e.reason]

@@ -11,6 +11,7 @@ from __future__ import annotations
 from roadgaze.config import MonitorConfig
 from roadgaze.monitor.context import Context
 from roadgaze.monitor.episode import step_episode
+from roadgaze.monitor.eye_rules import HIDDEN
 from roadgaze.monitor.eyes import measure_eyes
 from roadgaze.monitor.failures import frame_issue
 from roadgaze.monitor.look import classify, finite, to_driver_frame
@@ -52,7 +53,7 @@ def observe(
     issue = frame_issue(config, sample.frame_check)
     # ADDW's allowance applies when the service knows conditions are non-nominal: eyes hidden,
     # or a poor frame.
-    non_nominal = eyes.verdict.reason == "eyes hidden" or bool(issue)
+    non_nominal = eyes.verdict.reason.startswith(HIDDEN) or bool(issue)
     episode = step_episode(
         config,
         state.episode,

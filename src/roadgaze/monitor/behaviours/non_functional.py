@@ -5,11 +5,12 @@ Monitoring is not functional while, with a picture the camera check finds sound 
 blocked or saturated: those are the camera's failures, `temporary_failure`):
 - **the eyes are hidden**: a face is found and faces the road (its head pose in the road zone,
   so a turn away does not count), yet its measured eyes cannot be judged
-  (`roadgaze.monitor.eyes`: unavailable: a dark lens or a flat eye opening, low landmark
-  quality, a brim's shade or a fringe over them); a source that measures no eyes at all is not
-  this; or
+  (`roadgaze.monitor.eyes`: unavailable: a dark lens or a flat eye opening, strands across
+  both eyes (a fringe), a hand found in front of them (a fist gripping the top of the wheel in
+  front of the camera, on which MediaPipe still places a face), low landmark quality); a source
+  that measures no eyes at all is not this; or
 - **the face is hidden**: no face is found and its loss is not explained by a turn away (a hand
-  gripping the top of the wheel in front of the camera).
+  in front of the camera that leaves no face at all).
 Timed while moving: held `after` (`non_functional_after_s`), `non_functional` is raised with the
 reason, and published at every sample while in force (`non_functional` = `eyes_hidden` or
 `face_hidden`: the state message shows it permanently); raised again every `repeat` while the

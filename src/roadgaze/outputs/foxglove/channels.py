@@ -47,6 +47,7 @@ from roadgaze.capture.mcap_driver import (
 from roadgaze.config import MonitorConfig
 from roadgaze.errors import RoadgazeError
 from roadgaze.outputs.annotate import face_lines_px, verdict_text
+from roadgaze.outputs.hand_record import HAND_JSON_SCHEMA
 from roadgaze.outputs.plots import road_bands_deg, road_pitch_bands_deg, timer_thresholds
 from roadgaze.outputs.records import RECORD_SCHEMA, FieldType, record_fields, rounded
 from roadgaze.transport.message_base import Message
@@ -84,6 +85,7 @@ _JSON_TYPES: dict[FieldType, dict[str, Any]] = {
     FieldType.FLOAT: {"type": ["number", "null"]},
     FieldType.STR: {"type": ["string", "null"]},
     FieldType.STR_LIST: {"type": ["array", "null"], "items": {"type": "string"}},
+    FieldType.HANDS: {"type": ["array", "null"], "items": HAND_JSON_SCHEMA},
 }
 _LOG_LEVELS = {
     logging.DEBUG: LogLevel.Debug,

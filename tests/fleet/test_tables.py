@@ -54,6 +54,29 @@ def test_a_field_added_to_the_typed_record_appears_in_parquet(
     assert table.column("eyes_closed_s").to_pylist() == [0.5]
 
 
+def test_the_hands_with_their_landmarks_go_to_parquet_as_a_list_of_structs(
+    tmp_path: Path,
+) -> None:
+    import numpy as np
+
+    from roadgaze.types import Hand, HandSide, PhoneJudgement
+
+    landmarks = np.column_stack((np.arange(21.0) + 0.04, np.full(21, 7.26), np.zeros(21)))
+    hand = Hand(HandSide.LEFT, 0.8, 0.9, landmarks.astype(np.float32), (0.0, 7.0, 20.0, 8.0))
+    phone = PhoneJudgement(False, 0.1)
+    found = PoseSample(0.0, 0, False, None, None, None, None, None, 0, hands=(hand,), phone=phone)
+    path = tmp_path / "frames.parquet"
+    with AtomicParquetWriter(path, frames_schema(), CONSTANT) as writer:
+        writer.append(records.record_fields(record_of(found)))
+        writer.append(records.record_fields(record_of(replace(found, hands=None, phone=None))))
+        writer.commit({})
+    [with_hand, stage_off] = pq.read_table(path).column("hands").to_pylist()
+    assert stage_off is None
+    [row] = with_hand
+    assert (row["side"], row["side_score"], row["score"]) == ("left", 0.8, 0.9)
+    assert row["landmarks_px"][1] == [1.0, 7.3, 0.0] and len(row["landmarks_px"]) == 21
+
+
 def test_alerts_schema_has_every_alert_field_and_the_frame() -> None:
     names = alerts_schema().names
     assert names[:5] == ["drive_id", "driver_id", "vehicle_id", "start_time", "frame"]

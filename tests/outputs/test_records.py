@@ -67,6 +67,8 @@ def has_type(value: Any, field_type: FieldType) -> bool:
         return True
     if field_type is FieldType.STR_LIST:
         return isinstance(value, list) and all(isinstance(item, str) for item in value)
+    if field_type is FieldType.HANDS:
+        return isinstance(value, list) and all(isinstance(item, dict) for item in value)
     if field_type is FieldType.INT:
         return isinstance(value, int) and not isinstance(value, bool)
     if field_type is FieldType.FLOAT:

@@ -36,6 +36,16 @@ ARROW_TYPES: dict[FieldType, Any] = {
     FieldType.FLOAT: pa.float64(),
     FieldType.STR: pa.string(),
     FieldType.STR_LIST: pa.list_(pa.string()),
+    FieldType.HANDS: pa.list_(
+        pa.struct(
+            [
+                ("side", pa.string()),
+                ("side_score", pa.float64()),
+                ("score", pa.float64()),
+                ("landmarks_px", pa.list_(pa.list_(pa.float64(), 3))),
+            ]
+        )
+    ),
 }
 
 METADATA_KEY = b"roadgaze.drive"

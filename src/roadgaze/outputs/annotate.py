@@ -1,5 +1,5 @@
-"""The annotated video: face boundaries, centre line, a yaw gauge, the numbers, the verdict, the
-off-road timers and a banner per active alert.
+"""The annotated video: face boundaries, centre line, the eyes, the hands, a yaw gauge, the
+numbers, the verdict, the off-road timers, the phone judgement and a banner per active alert.
 
 Boundaries and centre are vertical lines in the roll-removed frame, drawn rotated back into the
 image. Everything drawn comes from the frame's `FrameRecord`; the text lines at the bottom are
@@ -21,6 +21,7 @@ import numpy.typing as npt
 
 from roadgaze.config import MonitorConfig
 from roadgaze.outputs.annotate_eyes import draw_eyes, eyes_line
+from roadgaze.outputs.annotate_hands import draw_hands, phone_line
 from roadgaze.outputs.video import FOURCC_BY_SUFFIX, open_video_writer
 from roadgaze.types import (
     AlertKind,
@@ -207,8 +208,8 @@ def annotate(
     monitor: MonitorConfig | None = None,
     banners: Sequence[Banner] = (),
 ) -> npt.NDArray[np.uint8]:
-    """A copy of `image` with the face geometry, the eyes (a box per eye, the gaze arrow), a yaw
-    gauge, the `PANEL_LINES` and the banners drawn."""
+    """A copy of `image` with the face geometry, the eyes (a box per eye, the gaze arrow), the
+    hands (each one's skeleton and side), a yaw gauge, the `PANEL_LINES` and the banners drawn."""
     import cv2
 
     canvas = image.copy()
@@ -227,9 +228,10 @@ def annotate(
             colour = (0, 255, 0) if name == "centre" else (0, 200, 255)
             cv2.line(canvas, (round(x0), round(y0)), (round(x1), round(y1)), colour, thickness)
     draw_eyes(canvas, record, scale)
+    draw_hands(canvas, record, scale)
     gauge_width = _draw_gauge(canvas, sample, scale)
     _draw_banners(canvas, banners, scale, thickness, width - gauge_width)
-    lines_text = [line(record, monitor) for line in PANEL_LINES]
+    lines_text = [text for line in PANEL_LINES if (text := line(record, monitor))]
     _draw_text_panel(canvas, lines_text, scale, thickness)
     return canvas
 
@@ -339,8 +341,15 @@ def timers_line(record: FrameRecord, monitor: MonitorConfig | None) -> str:
 
 
 PanelLine = Callable[[FrameRecord, MonitorConfig | None], str]
-PANEL_LINES: tuple[PanelLine, ...] = (yaw_line, state_line, gaze_line, timers_line, eyes_line)
-"""The text lines at the bottom of each frame, top to bottom."""
+PANEL_LINES: tuple[PanelLine, ...] = (
+    yaw_line,
+    state_line,
+    gaze_line,
+    timers_line,
+    eyes_line,
+    phone_line,
+)
+"""The text lines at the bottom of each frame, top to bottom (an empty one is left out)."""
 
 
 def _draw_gauge(canvas: npt.NDArray[np.uint8], sample: PoseSample, scale: float) -> int:

@@ -1,7 +1,8 @@
-"""The flat per-frame record (one definition) and the writers of it: JSON lines and CSV.
+"""The per-frame record (one definition) and the writers of it: JSON lines and CSV.
 
 `record_fields(record)` flattens a `FrameRecord` into the JSON-ready dict every writer uses:
-the pose sample's fields, then the monitor's verdict and the alerts raised on that frame.
+the pose sample's fields, then the monitor's verdict and the alerts raised on that frame, then
+the hands (`roadgaze.outputs.hand_record`; the one nested field, `hands`, is no CSV column).
 `RECORD_SCHEMA` types each of its fields (`alert_fields` and `ALERT_SCHEMA` do the same for one
 alert); columnar writers (the fleet's Parquet files) derive their schema from it.
 Every writer is a context manager and a pipeline sink (`on_record`, `on_alert`, `close`); an
@@ -12,55 +13,19 @@ from __future__ import annotations
 
 import csv
 import json
-import math
 from collections.abc import Iterator
 from contextlib import contextmanager
-from enum import StrEnum
 from pathlib import Path
 from typing import IO, Any
 
 from roadgaze.errors import RoadgazeError
 from roadgaze.monitor.behaviours.support import output_name, support_output
 from roadgaze.monitor.protocols.support import CHANNELS
-from roadgaze.types import (
-    Alert,
-    ClosesOnExit,
-    EyesVerdict,
-    Frame,
-    FrameRecord,
-    Hand,
-    HandSide,
-    PhoneJudgement,
-    Sink,
-    Verdict,
-)
-
-
-class FieldType(StrEnum):
-    """The type of one field of a flat record; every field may also be None (null)."""
-
-    BOOL = "bool"
-    INT = "int"
-    FLOAT = "float"
-    STR = "str"
-    STR_LIST = "list[str]"
-
-
-HAND_SCHEMA: tuple[tuple[str, FieldType], ...] = (
-    ("n_hands", FieldType.INT),
-    ("hand_left_score", FieldType.FLOAT),
-    ("hand_left_x", FieldType.FLOAT),
-    ("hand_left_y", FieldType.FLOAT),
-    ("hand_right_score", FieldType.FLOAT),
-    ("hand_right_x", FieldType.FLOAT),
-    ("hand_right_y", FieldType.FLOAT),
-    ("phone_use", FieldType.BOOL),
-    ("phone_score", FieldType.FLOAT),
-    ("phone_hand", FieldType.STR),
-    ("phone_pose", FieldType.STR),
-)
-"""The hands and the phone judgement (`hand_fields`): null while the hand stage is off; per
-side (the driver's own) the best hand's presence score and the centre of its box in pixels."""
+from roadgaze.outputs.field_types import FieldType as FieldType
+from roadgaze.outputs.field_types import rounded as rounded
+from roadgaze.outputs.hand_record import HAND_SCHEMA as HAND_SCHEMA
+from roadgaze.outputs.hand_record import hand_fields as hand_fields
+from roadgaze.types import Alert, ClosesOnExit, EyesVerdict, Frame, FrameRecord, Sink, Verdict
 
 RECORD_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("t_s", FieldType.FLOAT),
@@ -118,6 +83,8 @@ fields as `roadgaze.types.EyesVerdict` defines them, `eyes` is open, closed or u
 field added to `record_fields` is added here too (a test checks it)."""
 
 RECORD_FIELDS = tuple(name for name, _ in RECORD_SCHEMA)
+CSV_FIELDS = tuple(name for name, kind in RECORD_SCHEMA if kind is not FieldType.HANDS)
+"""The fields of the CSV file: all but the nested `hands` (a cell holds one value)."""
 """The fields of `record_fields`, in order. `yaw_offline_deg` / `pitch_offline_deg` are null
 while a replay streams; `fill_offline_columns` fills them at its end."""
 
@@ -140,13 +107,6 @@ ALERT_SCHEMA: tuple[tuple[str, FieldType], ...] = (
     ("source", FieldType.STR),
 )
 """Every field of `alert_fields`: the content of an `AlertMessage` without its wire fields."""
-
-
-def rounded(value: float | None, digits: int) -> float | None:
-    """`value` rounded for a record; None for None, NaN or infinity."""
-    if value is None or not math.isfinite(value):
-        return None
-    return round(float(value), digits)
 
 
 def record_fields(record: FrameRecord) -> dict[str, Any]:
@@ -226,26 +186,6 @@ def support_fields(verdict: Verdict) -> dict[str, Any]:
     for channel in CHANNELS:
         output = support_output(verdict, channel)
         fields[output_name(channel)] = None if output is None else output.value
-    return fields
-
-
-def hand_fields(hands: tuple[Hand, ...] | None, phone: PhoneJudgement | None) -> dict[str, Any]:
-    """The hand part of the record (`HAND_SCHEMA`); all null while the hand stage is off."""
-    fields: dict[str, Any] = {"n_hands": None if hands is None else len(hands)}
-    for side in HandSide:
-        best = max(
-            (hand for hand in hands or () if hand.side is side),
-            key=lambda hand: hand.score,
-            default=None,
-        )
-        box = None if best is None else best.box_px
-        fields[f"hand_{side.value}_score"] = None if best is None else rounded(best.score, 3)
-        fields[f"hand_{side.value}_x"] = None if box is None else rounded((box[0] + box[2]) / 2, 1)
-        fields[f"hand_{side.value}_y"] = None if box is None else rounded((box[1] + box[3]) / 2, 1)
-    fields["phone_use"] = None if phone is None else phone.phone_use
-    fields["phone_score"] = None if phone is None else rounded(phone.score, 3)
-    fields["phone_hand"] = None if phone is None or phone.hand is None else phone.hand.value
-    fields["phone_pose"] = None if phone is None or phone.pose is None else phone.pose.value
     return fields
 
 
@@ -331,7 +271,8 @@ class JsonlWriter(ClosesOnExit, Sink):
 
 
 class CsvWriter(ClosesOnExit, Sink):
-    """The same records as CSV; empty cells for null."""
+    """The same records as CSV (`CSV_FIELDS`: all but the nested `hands`); empty cells for
+    null."""
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
@@ -350,7 +291,8 @@ class CsvWriter(ClosesOnExit, Sink):
         assert self._file is not None, "writer is closed"
         with naming(self.path):
             if self._writer is None:
-                self._writer = csv.DictWriter(self._file, fieldnames=list(fields))
+                names = [name for name in fields if name in CSV_FIELDS]
+                self._writer = csv.DictWriter(self._file, fieldnames=names, extrasaction="ignore")
                 self._writer.writeheader()
             self._writer.writerow({k: "" if v is None else v for k, v in fields.items()})
 

@@ -47,6 +47,8 @@ from roadgaze.capture.mcap_driver import (
 from roadgaze.config import MonitorConfig
 from roadgaze.errors import RoadgazeError
 from roadgaze.outputs.annotate import face_lines_px, verdict_text
+from roadgaze.outputs.foxglove.hand_annotations import hand_annotations
+from roadgaze.outputs.hand_record import HAND_JSON_SCHEMA
 from roadgaze.outputs.plots import road_bands_deg, road_pitch_bands_deg, timer_thresholds
 from roadgaze.outputs.records import RECORD_SCHEMA, FieldType, record_fields, rounded
 from roadgaze.transport.message_base import Message
@@ -84,6 +86,7 @@ _JSON_TYPES: dict[FieldType, dict[str, Any]] = {
     FieldType.FLOAT: {"type": ["number", "null"]},
     FieldType.STR: {"type": ["string", "null"]},
     FieldType.STR_LIST: {"type": ["array", "null"], "items": {"type": "string"}},
+    FieldType.HANDS: {"type": ["array", "null"], "items": HAND_JSON_SCHEMA},
 }
 _LOG_LEVELS = {
     logging.DEBUG: LogLevel.Debug,
@@ -187,8 +190,8 @@ def face_annotations(
     record: FrameRecord, stamp_ns: int, scale: float, with_landmarks: bool
 ) -> ImageAnnotations:
     """The frame's face box, boundaries (orange) and centre line (green) rotated back from the
-    roll-removed frame, its landmarks (`with_landmarks`), the verdict's line and the active
-    alerts, in the pixels of the image scaled by `scale`."""
+    roll-removed frame, its landmarks (`with_landmarks`), the hands (`hand_annotations`), the
+    verdict's line and the active alerts, in the pixels of the image scaled by `scale`."""
     stamp = timestamp(stamp_ns)
 
     def shape(
@@ -225,6 +228,9 @@ def face_annotations(
             xy = features.landmarks_px[:, :2].tolist()
             points.append(shape(PointsAnnotationType.Points, xy, LANDMARK_COLOUR, 2.0))
     texts = [text(20.0, verdict_text(record), TEXT_BACKGROUND)]
+    hand_points, hand_texts = hand_annotations(record, stamp, scale)
+    points += hand_points
+    texts += hand_texts
     if record.verdict.active:
         active = ", ".join(kind.value for kind in record.verdict.active)
         texts.append(text(42.0, f"ACTIVE: {active}", ALERT_BACKGROUND))

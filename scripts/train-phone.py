@@ -38,7 +38,7 @@ from roadgaze.evaluation.phone import (  # noqa: E402
 from roadgaze.phone.boosting import BoostSettings, fit  # noqa: E402
 from roadgaze.phone.features import FEATURES  # noqa: E402
 
-VERSION = "2"
+VERSION = "3"
 CANDIDATES = (
     BoostSettings(trees=40, depth=2, learning_rate=0.15),
     BoostSettings(trees=80, depth=3, learning_rate=0.1),

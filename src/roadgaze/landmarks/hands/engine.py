@@ -34,8 +34,9 @@ class HandArrays:
     presence: float
     """The model's hand-presence score, 0..1."""
     handedness: float
-    """The model's 0..1 score for MediaPipe's label `Right` (> 0.5). MediaPipe labels hands as
-    if the image were mirrored, so on an unmirrored camera `Right` is the person's own left."""
+    """The model's 0..1 score for MediaPipe's label `Left` (> 0.5; its first label, the
+    binary classifier's). MediaPipe labels hands as if the image were mirrored, so on an
+    unmirrored camera `Left` is the person's own right hand (`roadgaze.landmarks.hands.stage`)."""
 
 
 PALM = SsdSpec("palm", graph.PALM_SIZE, graph.PALM_STRIDES, graph.PALM_NMS_IOU, 1.0 / 255.0)

@@ -29,12 +29,14 @@ log = logging.getLogger(__name__)
 
 
 def to_hand(found: HandArrays, size: tuple[int, int]) -> Hand:
-    """A hand in pixels with the person's own side. MediaPipe's handedness model labels hands
-    as if the image were mirrored (a selfie camera): on a cabin camera, which is not mirrored,
-    its `Right` (score > 0.5) is the person's own left hand."""
+    """A hand in pixels with the person's own side. The handedness score is the model's score
+    of `Left` (MediaPipe's binary classifier: its first label, `handedness.txt` being
+    `Left`, `Right`), and MediaPipe labels hands as if the image were mirrored (a selfie
+    camera): on a cabin camera, which is not mirrored, its `Left` (score > 0.5) is the person's
+    own right hand, its `Right` (score < 0.5) their own left."""
     scale = np.array([size[0], size[1], size[0]], np.float32)
     points = (found.points * scale).astype(np.float32)
-    own_left = found.handedness > 0.5
+    own_left = found.handedness < 0.5
     box = (
         float(points[:, 0].min()),
         float(points[:, 1].min()),

@@ -48,13 +48,16 @@ def test_without_the_calculator_one_line_says_how_to_install_it(
 
 @pytest.mark.slow
 def test_a_run_writes_the_dossier_and_prints_the_official_score(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    """Run as a user types it, with relative paths (the calculator's commands run in their own
+    folder: a relative --out once sent their output nowhere)."""
     openpyxl = pytest.importorskip("openpyxl", reason="needs roadgaze[euroncap]")
     pytest.importorskip("euroncap_rating_2026", reason="needs roadgaze[euroncap]")
+    monkeypatch.chdir(tmp_path)
     dossier = tmp_path / "d.xlsx"
-    args = ["--protocol", "euroncap", "--only", "microsleep_70", "--out", str(tmp_path)]
-    code = main(["conformance", *args, "--dossier", str(dossier), "--score"])
+    args = ["--protocol", "euroncap", "--only", "microsleep_70", "--out", "."]
+    code = main(["conformance", *args, "--dossier", "d.xlsx", "--score"])
     out = capsys.readouterr().out
     assert code == 0
     ws = openpyxl.load_workbook(dossier)["DE - DM pred."]

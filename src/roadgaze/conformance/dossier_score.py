@@ -60,8 +60,9 @@ class Calculator:
     `euroncap_rating_2026.log`, stays there)."""
 
     def __init__(self, workdir: Path) -> None:
-        self.workdir = workdir
-        workdir.mkdir(parents=True, exist_ok=True)
+        # Absolute: the commands run in it, and its path is passed to them as their output.
+        self.workdir = workdir.resolve()
+        self.workdir.mkdir(parents=True, exist_ok=True)
 
     def _run(self, command: str, *args: str) -> None:
         argv = [sys.executable, "-P", "-m", "euroncap_rating_2026", "safe_driving", command, *args]

@@ -48,7 +48,7 @@ def test_the_off_road_time_of_glances_follows_the_eased_turn(yaw_deg: float) -> 
 def test_vats_is_expected_when_the_heads_path_reaches_the_threshold() -> None:
     """A far target leaves the road early and comes back late: its glances' off-road time is
     longer than their length, so VATS is due earlier than the lengths alone say; the window is
-    the timer's margins around that. Eyes-only glances keep the glances' lengths."""
+    the distraction warnings' margins around that. Eyes-only glances keep the glances' lengths."""
     glances = [Segment(3.0, label="ahead")]
     for index in range(5):
         glances += [Segment(2.2, -55.0, -30.0, label="look" if index == 0 else f"g{index}")]
@@ -56,7 +56,7 @@ def test_vats_is_expected_when_the_heads_path_reaches_the_threshold() -> None:
     far = expect.vats(MONITOR, "far.warns", "far", glances, 4 * 1.2)
     reached = expect.off_road_reached_s(MONITOR, glances, "look", 10.0)
     assert reached is not None and reached < 10.0 + 4 * 1.2
-    assert far.window_s == pytest.approx((reached - 0.5, reached + 0.6))
+    assert far.window_s == pytest.approx((reached - 1.5, reached + 0.6))
     eyes = [Segment(s.duration_s, 0.0, 0.0, s.yaw_deg, s.pitch_deg, label=s.label) for s in glances]
     lizard = expect.vats(MONITOR, "eyes.warns", "eyes", eyes, 4 * 1.2)
-    assert lizard.window_s == pytest.approx((14.8 - 0.5, 14.8 + 0.6))
+    assert lizard.window_s == pytest.approx((14.8 - 1.5, 14.8 + 0.6))

@@ -147,10 +147,15 @@ def vats(
     nominal_offset_s: float,
     from_label: str = "look",
 ) -> Requirement:
-    """VATS within the measurement's margins of when the glances' off-road time reaches its
-    threshold: the rendered head's (`off_road_reached_s`) for glances of the head alone; for
-    glances that move the eyes, each glance's off-road time taken as its length, plus
-    `nominal_offset_s` (the road between the glances)."""
+    """VATS within the distraction warnings' margins (`EARLY_S`, `LATENCY_S`) of when the
+    glances' off-road time reaches its threshold: the rendered head's (`off_road_reached_s`) for
+    glances of the head alone; for glances that move the eyes, each glance's off-road time taken
+    as its length, plus `nominal_offset_s` (the road between the glances).
+
+    The early margin is the long distraction's, not a sharp event's (`TIMER_EARLY_S`): VATS adds
+    up the measured edges of five glances, and each edge the pose crosses a frame or two apart
+    from the rendered head (more so under a cap or a mask); that four glances stay below the
+    threshold is checked on its own (`vats_below_70`)."""
     rule = euroncap.VATS
     threshold_s = rule.value(config)
     if threshold_s is None:
@@ -158,7 +163,7 @@ def vats(
     eyes_move = any((s.eye_yaw_deg, s.eye_pitch_deg) != (0.0, 0.0) for s in segments)
     reached_s = None if eyes_move else off_road_reached_s(config, segments, from_label, threshold_s)
     expected_s = threshold_s + nominal_offset_s if reached_s is None else reached_s
-    window = (expected_s - TIMER_EARLY_S, expected_s + LATENCY_S)
+    window = (expected_s - EARLY_S, expected_s + LATENCY_S)
     return Requirement(
         key, text, source_of(rule), ("vats",), window, from_label, applies(config, rule)
     )

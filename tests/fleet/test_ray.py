@@ -141,8 +141,8 @@ def ray_head(tmp_path: Path, ray_tmp: Path) -> Iterator[str]:
     finally:
         with contextlib.suppress(ProcessLookupError):  # gone already: its log says why
             os.killpg(head.pid, signal.SIGTERM)
-        try:
-            head.wait(timeout=30)
+        try:  # `ray start --block` took the whole 30 s it was once given: a head of our own,
+            head.wait(timeout=5)  # in a folder of its own, is killed after 5
         except subprocess.TimeoutExpired:
             os.killpg(head.pid, signal.SIGKILL)
             head.wait()

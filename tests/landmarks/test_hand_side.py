@@ -28,6 +28,7 @@ def test_the_handedness_score_is_mediapipes_left_seen_in_a_mirror(
     assert hand.side_score == pytest.approx(max(handedness, 1.0 - handedness))
 
 
+@pytest.mark.slow
 def test_the_hands_side_agrees_with_the_bodys_wrist_on_real_drivers() -> None:
     """On every 40th State Farm development image: a hand whose wrist lies within one hand's
     size of a body wrist takes that wrist's side (measured: 75 of 86 on every 15th image; the

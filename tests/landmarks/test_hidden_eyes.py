@@ -29,6 +29,7 @@ def measured() -> dict[str, EyesFeatures | None]:
     return result
 
 
+@pytest.mark.slow
 def test_a_fringe_hides_the_eyes_and_what_leaves_them_in_view_does_not(
     measured: dict[str, EyesFeatures | None],
 ) -> None:

@@ -48,6 +48,7 @@ def test_a_hand_hides_the_eyes_only_when_its_outline_holds_both() -> None:
     assert not hand_over_eyes([fist], face_at(0.0))  # a source without MediaPipe's 478 points
 
 
+@pytest.mark.slow
 def test_a_rendered_fist_at_the_wheels_top_is_found_in_front_of_the_eyes() -> None:
     """The rendered hand of `notice_hand_at_12_70` (a camera on the steering column), through
     the real face landmarker and hand stage: the face found on the fist has both irises inside

@@ -5,6 +5,8 @@ off (`sample.hands` None)."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import numpy.typing as npt
 
@@ -32,31 +34,49 @@ def hand_label(hand: Hand, holds_phone: bool = False) -> str:
     return text + "  PHONE" if holds_phone else text
 
 
-def draw_hands(canvas: npt.NDArray[np.uint8], record: FrameRecord, scale: float) -> None:
-    """Each hand of the record: its skeleton, its landmarks and its label above its box, in the
-    colour of its side (red for the hand holding a phone)."""
-    import cv2
+@dataclass(frozen=True, slots=True)
+class DrawnHand:
+    """A hand as the video and the recording's annotations draw it."""
 
+    points_px: npt.NDArray[np.float64]
+    """(21, 2) its landmarks in the image's pixels, all finite."""
+    colour_bgr: tuple[int, int, int]
+    """Its side's colour, or red for the hand holding a phone."""
+    label: str
+
+
+def drawn_hands(record: FrameRecord) -> list[DrawnHand]:
+    """The hands of `record` to draw: those whose 21 landmarks are finite, each with its colour
+    and `hand_label`; none while the hand stage is off or no hand is found."""
     sample = record.sample
-    if not sample.hands:
-        return
     phone = sample.phone
     phone_hand = phone.hand if phone is not None and phone.phone_use else None
-    thickness = max(1, round(2 * scale))
-    for hand in sample.hands:
+    drawn = []
+    for hand in sample.hands or ():
         points = np.asarray(hand.landmarks_px, dtype=np.float64)[:, :2]
         if points.shape != (21, 2) or not np.isfinite(points).all():
             continue
         holds_phone = hand.side is phone_hand
         colour = PHONE_HAND_BGR if holds_phone else HAND_COLOURS_BGR[hand.side]
-        pixels = [(round(x), round(y)) for x, y in points]
+        drawn.append(DrawnHand(points, colour, hand_label(hand, holds_phone)))
+    return drawn
+
+
+def draw_hands(canvas: npt.NDArray[np.uint8], record: FrameRecord, scale: float) -> None:
+    """Each hand of the record: its skeleton, its landmarks and its label above its box, in the
+    colour of its side (red for the hand holding a phone)."""
+    import cv2
+
+    thickness = max(1, round(2 * scale))
+    for hand in drawn_hands(record):
+        pixels = [(round(x), round(y)) for x, y in hand.points_px]
         for start, end in HAND_CONNECTIONS:
-            cv2.line(canvas, pixels[start], pixels[end], colour, thickness, cv2.LINE_AA)
+            cv2.line(canvas, pixels[start], pixels[end], hand.colour_bgr, thickness, cv2.LINE_AA)
         for pixel in pixels:
             cv2.circle(canvas, pixel, thickness + 1, (255, 255, 255), -1, cv2.LINE_AA)
-        x_min, y_min = points.min(axis=0)
+        x_min, y_min = hand.points_px.min(axis=0)
         corner = (round(x_min), round(y_min))
-        _draw_label(canvas, hand_label(hand, holds_phone), corner, colour, scale)
+        _draw_label(canvas, hand.label, corner, hand.colour_bgr, scale)
 
 
 def _draw_label(

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from roadgaze.capture.base import SourceBase, SourceInfo, SourceStatus
-from roadgaze.conformance.model import CameraState, Scenario
+from roadgaze.conformance.model import CameraState, Scenario, segments_timeline
 from roadgaze.mounting import Cabin, head_to_camera, mounting_for
 from roadgaze.synth.clip import write_truth_csv
 from roadgaze.synth.effects import NoiseBank, covered_frame, night
@@ -40,7 +40,7 @@ from roadgaze.synth.occluders import hand_layer
 from roadgaze.synth.outfit import WORN, Outfit, check_conditions
 from roadgaze.synth.phone_hand import PLACES, phone_hand_layer
 from roadgaze.synth.renderer import ImageBGR
-from roadgaze.synth.timeline import DEFAULT_TRANSITION_S, Keyframe, Timeline, eased
+from roadgaze.synth.timeline import DEFAULT_TRANSITION_S, eased
 from roadgaze.types import FloatArray, Frame
 
 MOUTH_STEP = 0.02
@@ -49,18 +49,6 @@ a held pose with a talking mouth reuses its frames."""
 SPEED_PERIOD_S = 0.5
 """A speed sample every half second (a CAN speed signal comes at 10-50 Hz; the track holds)."""
 CLIP_SUFFIX = ".mkv"
-
-
-def timeline_of(scenario: Scenario) -> Timeline:
-    """The scenario's head and eye poses (driver's frame) as a synth timeline."""
-    return Timeline(
-        tuple(
-            Keyframe(
-                s.yaw_deg, s.pitch_deg, s.duration_s, s.eye_yaw_deg, s.eye_pitch_deg, s.openness
-            )
-            for s in scenario.segments
-        )
-    )
 
 
 def leans_m(scenario: Scenario, t_s: FloatArray) -> FloatArray:
@@ -191,7 +179,7 @@ class ScenarioRenderer:
         """Every frame of the scenario, in order (rendered as they are asked for). Raises
         ConfigError for a condition that does not exist."""
         check_conditions(scenario.conditions)
-        truth = timeline_of(scenario).eye_truth(self.fps)
+        truth = segments_timeline(scenario.segments).eye_truth(self.fps)
         states = camera_states(scenario, truth[:, 0])
         leans = leans_m(scenario, truth[:, 0])
         seed = zlib.crc32(scenario.name.encode())
@@ -222,9 +210,8 @@ class ScenarioRenderer:
     def write_side_files(self, scenario: Scenario, folder: Path) -> Path | None:
         """`NAME.truth.csv` and, with a speed, `NAME.speed.csv` in `folder`; returns the track."""
         folder.mkdir(parents=True, exist_ok=True)
-        write_truth_csv(
-            folder / f"{scenario.name}.truth.csv", timeline_of(scenario).eye_truth(self.fps)
-        )
+        truth = segments_timeline(scenario.segments).eye_truth(self.fps)
+        write_truth_csv(folder / f"{scenario.name}.truth.csv", truth)
         track = folder / f"{scenario.name}.speed.csv"
         track.unlink(missing_ok=True)
         if scenario.speed_kmh is None:

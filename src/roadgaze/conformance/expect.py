@@ -12,10 +12,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from roadgaze.config import MonitorConfig
-from roadgaze.conformance.model import Requirement, Segment
+from roadgaze.conformance.model import Requirement, Segment, segments_timeline
 from roadgaze.monitor.protocols import Rule, Trigger, addw, distraction_trigger, euroncap, uses
 from roadgaze.monitor.zones import ROAD, ZoneMap
-from roadgaze.synth.timeline import Keyframe, Timeline
 
 LATENCY_S = 0.6
 """How much later than the rule's time a warning may come, measured from the start of the look:
@@ -119,7 +118,7 @@ def off_road_reached_s(
     included, which the target's distance from that edge sets (a far target leaves the road early
     in the turn and comes back late). For looks that move the head only: the eyes' share of a
     lizard look passes the gaze's calibration and dead band first."""
-    timeline = Timeline(tuple(Keyframe(s.yaw_deg, s.pitch_deg, s.duration_s) for s in segments))
+    timeline = segments_timeline(segments)
     start_s = 0.0
     for segment in segments:
         if segment.label == from_label:

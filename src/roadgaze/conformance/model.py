@@ -11,8 +11,11 @@ protocol rule tables (`roadgaze.conformance.expect`), never written down here.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
+
+from roadgaze.synth.timeline import Keyframe, Timeline
 
 CameraState = Literal["face", "no_face", "covered", "frozen"]
 """What the camera delivers during a segment: the driver, the cabin without a face, a covered
@@ -162,3 +165,16 @@ def judge(
     if measured is None or not math.isfinite(measured):
         return measured, False
     return measured, window[0] - 1e-9 <= measured <= window[1] + 1e-9
+
+
+def segments_timeline(segments: Sequence[Segment]) -> Timeline:
+    """The segments' head and eye poses (driver's frame) as a synth timeline: what is rendered,
+    and what the expected windows follow (`roadgaze.conformance.expect.off_road_reached_s`)."""
+    return Timeline(
+        tuple(
+            Keyframe(
+                s.yaw_deg, s.pitch_deg, s.duration_s, s.eye_yaw_deg, s.eye_pitch_deg, s.openness
+            )
+            for s in segments
+        )
+    )

@@ -4,6 +4,7 @@ then the real MediaPipe landmarker on a stream where a second face comes and goe
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -150,6 +151,57 @@ def test_a_face_that_moves_away_from_the_tracked_place_is_found_on_the_same_fram
         moved = detector.detect(right, 0.5).driver
         assert detector.face_mode is FaceMode.SINGLE
     assert moved is not None and moved.box_px[0] > 400
+
+
+def test_a_count_on_a_jump_waits_for_the_periodic_count_of_the_same_frame(
+    model_path: Path,
+) -> None:
+    """The periodic count runs on its own thread; a jump on the same frame asks for a count at
+    once. Both use one detector (its input buffer, LiteRT's interpreter), which must never run
+    twice at a time: LiteRT refused with "at least 1 reference to internal data" and the run
+    ended (a replay under load). The counts now follow each other on the counting thread."""
+    import threading
+    import time
+
+    face = cv2.cvtColor(skimage_data.astronaut()[20:260, 120:340], cv2.COLOR_RGB2BGR)
+    left = np.full((260, 700, 3), 255, np.uint8)
+    left[10:250, 0:220] = face
+    right = np.full((260, 700, 3), 255, np.uint8)
+    right[10:250, 470:690] = face
+    overlaps, counts = [], []
+    busy = threading.Lock()
+
+    class OneAtATime:
+        """The detector, slowed down, noting a second count that starts while one runs."""
+
+        def __init__(self, counter: Any) -> None:
+            self.counter = counter
+
+        def count(self, image: Any) -> int:
+            if not busy.acquire(blocking=False):
+                overlaps.append(threading.current_thread().name)
+                return int(self.counter.count(image))
+            try:
+                time.sleep(0.3)
+                counts.append(threading.current_thread().name)
+                return int(self.counter.count(image))
+            finally:
+                busy.release()
+
+        def close(self) -> None:
+            self.counter.close()
+
+    config = LandmarksConfig(multi_face_check_s=0.5)
+    with MediaPipeLandmarker(config, model_path, video=True) as detector:
+        slow = OneAtATime(detector._counter)
+        detector._background.close()  # type: ignore[union-attr]
+        detector._counter = slow  # type: ignore[assignment]
+        detector._background = BackgroundCount(slow)
+        for index in range(5):
+            assert detector.detect(left, index / 10).driver is not None
+        moved = detector.detect(right, 0.5).driver  # the periodic count is due: and a jump
+    assert moved is not None and moved.box_px[0] > 400
+    assert overlaps == [] and len(counts) >= 3
 
 
 def test_a_periodic_count_is_taken_at_the_next_frame_even_when_it_is_slow() -> None:

@@ -286,14 +286,14 @@ class Landmarker(ClosesOnExit):
         self, mp_image: Any, size: tuple[int, int], t_s: float, timestamp_ms: int | None
     ) -> list[FoundFace]:
         """One frame of a stream: the one-face landmarker unless a count sees several faces."""
-        switch, counter, background = self._switch, self._counter, self._background
-        assert switch is not None and counter is not None and background is not None
+        switch, background = self._switch, self._background
+        assert switch is not None and background is not None
         started = background.take()  # a count started on the previous frame
         if started is not None:
             switch.counted(*started)
         if switch.check_due(t_s):
             if switch.next_check_t_s is None:  # the first frame: counted before it is tracked
-                switch.counted(t_s, counter.count(mp_image))
+                switch.counted(t_s, background.now(mp_image))
             else:  # the periodic count, beside this frame's landmarks, taken at the next frame
                 background.start(t_s, mp_image)
         if switch.mode is FaceMode.SINGLE:
@@ -306,7 +306,7 @@ class Landmarker(ClosesOnExit):
             box = faces[0].box_px if faces else None
             if not switch.jumped(t_s, box) and not self._elsewhere(box):
                 return faces
-            switch.counted(t_s, counter.count(mp_image))
+            switch.counted(t_s, background.now(mp_image))
             if not switch.multi:
                 return faces
             return self._find(self._landmarker, mp_image, size, self._next_ms())

@@ -173,6 +173,11 @@ class BackgroundCount:
         if self._pending is None:
             self._pending = (t_s, self._pool.submit(self._counter.count, image))
 
+    def now(self, image: Any) -> int:
+        """Faces in `image`, counted at once, on the counting thread after any pending count: the
+        counter (a detector with its own buffers) never runs twice at the same time."""
+        return self._pool.submit(self._counter.count, image).result()
+
     def take(self) -> tuple[float, int] | None:
         """(t_s, faces) of the count started (waiting for it: it ran beside a whole frame's
         landmarks, so it is done), None when none was started. Raises what the count raised."""

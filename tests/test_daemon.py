@@ -277,6 +277,8 @@ def test_daemon_sigterm_publishes_final_state_and_its_token_goes_away(
         stop_process(daemon)
     assert code == 0, stderr[-2000:]
     assert wait_for(lambda: recorder.alive == [True, False], timeout_s=5.0)
+    # The token's DELETE and the final state travel apart: either may come first.
+    assert wait_for(lambda: any(s["status"] == "stopped" for s in recorder.of("state")), 5.0)
     final = recorder.of("state")[-1]
     assert final["status"] == "stopped"
     assert final["frames"] == len(recorder.of("yaw"))  # the final state counts every frame sent

@@ -203,15 +203,22 @@ class AlertConsumer(ClosesOnExit):
     # The caller's thread.
 
     def subscribe(self, stopped: Callable[[], bool] = _never) -> None:
-        """Declare the subscriptions: the liveliness token first (waiting up to
-        `ALIVE_HISTORY_S` for its history, so a running daemon's `PublisherJoined` comes before
-        its cached alerts), then alerts, state, yaw and VSS as asked."""
+        """Declare the subscriptions: once the session's links are told, the liveliness token
+        (waiting up to `ALIVE_HISTORY_S` for its history, so a running daemon's `PublisherJoined`
+        comes before its cached alerts), then alerts, state, yaw and VSS as asked."""
         from zenoh.ext import HistoryConfig, RecoveryConfig, declare_advanced_subscriber
 
         if self.subscribed:
             return
         self.subscribed = True
         session, keys = self.session, self.keys
+        # The links the session already has are told first (the transport listener's history
+        # comes on Zenoh's thread, in no set order with the liveliness history): a publisher is
+        # never seen before the link it came by.
+        linked = [*session.info.routers_zid(), *session.info.peers_zid()]
+        deadline = time.monotonic() + ALIVE_HISTORY_S
+        while linked and not self.ever_connected and time.monotonic() < deadline and not stopped():
+            time.sleep(0.02)
         self._entities.append(
             session.liveliness().declare_subscriber(keys.alive, self._on_alive, history=True)
         )

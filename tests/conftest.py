@@ -67,6 +67,27 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
     return FileOrFolderScheduling(config, log)
 
 
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Before any test (in the controller of a parallel run, before its workers start): the
+    face and hand models in the default cache, as `roadgaze model fetch` puts them. On a fresh
+    machine the first test to need them fetched them while others already ran without: the
+    demo then warned that phone detection was off, and tests built no hand stage. Where they
+    cannot be had (no network), the tests that need them skip, as before."""
+    if hasattr(session.config, "workerinput"):
+        return
+    from roadgaze.config import load_config
+    from roadgaze.errors import ModelError
+    from roadgaze.landmarks.hands.models import fetch_hand_models
+    from roadgaze.landmarks.model_store import fetch_model
+
+    config = load_config(environ={}).model
+    for fetch in (fetch_model, fetch_hand_models):
+        try:
+            fetch(config)
+        except ModelError as exc:
+            logging.getLogger(__name__).warning("models for the tests: %s", exc)
+
+
 @pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """On a worker, the heaviest scopes first, so the run does not end waiting on one long

@@ -39,6 +39,13 @@ def test_every_sheet_location_is_named_once_with_a_source() -> None:
         "rear_view_mirror",
         "passenger_side_mirror",
         "instrument_cluster",
+        # where the phone-use rows put the phone
+        "phone_dashboard_outboard",
+        "driver_knee_outboard",
+        "driver_lap",
+        "driver_inboard",
+        "phone_dedicated_mount",
+        "phone_wheel_centre",
     )
     assert all(loc.source for loc in LOCATIONS)
     driving = {loc.name for loc in LOCATIONS if loc.driving_task}

@@ -3,7 +3,9 @@
 **Locations.** Euro NCAP 2026's driver-monitoring sheet ("DE - DM pred." of its rating
 calculator's template) names the places a driver looks at: the driver-side window, the
 infotainment system, the passenger footwell, the passenger's face, the passenger-side window,
-the glovebox, the rear passenger, the three mirrors and the instrument cluster. Each `Location`
+the glovebox, the rear passenger, the three mirrors and the instrument cluster, and where its
+phone-use rows put the phone (mounted on the dashboard outboard or on a dedicated place, at the
+driver's outer knee, in the lap, low inboard, held at the wheel's centre). Each `Location`
 here is one of them as a point in the driver's frame (x forward, y to the driver's left, z up,
 metres from the driver's eyes at their driving place), for a left-hand-drive cabin; a
 right-hand-drive cabin mirrors it (y changes sign; the names say "driver side" and "passenger
@@ -126,8 +128,36 @@ LOCATIONS: tuple[Location, ...] = (
         "passenger_side_mirror", "Passenger side mirror", (0.95, -1.30, -0.10), DRIVING_TASK, _OWN
     ),
     Location("instrument_cluster", "Instrument cluster", (0.75, 0.0, -0.20), DRIVING_TASK, _OWN),
+    # Where the phone-use rows put the phone (a phone looked at, not held up to the camera).
+    Location(
+        "phone_dashboard_outboard",
+        "Phone mounted on dashboard outboard",
+        (0.55, 0.35, -0.35),
+        NON_DRIVING,
+        _OWN,
+    ),
+    Location(
+        "driver_knee_outboard", "Driver knee outboard", (0.40, 0.25, -0.60), NON_DRIVING, _OWN
+    ),
+    Location("driver_lap", "Driver lap", (0.35, 0.0, -0.55), NON_DRIVING, _OWN),
+    Location("driver_inboard", "Driver inboard", (0.35, -0.25, -0.55), NON_DRIVING, _OWN),
+    Location(
+        "phone_dedicated_mount",
+        "Phone mounted on dedicated position",
+        (0.55, -0.35, -0.50),
+        NON_DRIVING,
+        _OWN,
+    ),
+    Location(
+        "phone_wheel_centre",
+        "Phone held centre of steering wheel",
+        (0.45, 0.0, -0.28),
+        NON_DRIVING,
+        _OWN,
+    ),
 )
-"""The sheet's gaze locations in a left-hand-drive cabin (`locations_for` mirrors them)."""
+"""The sheet's gaze locations in a left-hand-drive cabin (`locations_for` mirrors them): the
+looks of the distraction rows, then the phone's places of the phone-use rows."""
 LOCATION_NAMES = tuple(loc.name for loc in LOCATIONS)
 
 

@@ -54,6 +54,9 @@ def test_drowsy_at_70_warns_alert_at_70_and_drowsy_at_40_do_not(tmp_path: Path) 
     outcomes = {r["requirement"]: r for r in results["outcomes"]}
     assert {k: outcomes[k]["result"] for k in outcomes} == {
         "drowsy_70.warns": "PASS",
+        # forward and lane support from the warning to the end of the trip (row 68)
+        "drowsy_70.support_forward": "PASS",
+        "drowsy_70.support_lane": "PASS",
         "alert_70.quiet": "PASS",
         "drowsy_40.quiet": "PASS",
     }

@@ -115,3 +115,51 @@ def test_a_cabin_s_own_location_is_where_the_scenarios_look() -> None:
     assert (look.yaw_deg, look.pitch_deg) == pytest.approx(direction_deg((0.6, -0.9, -0.6)))
     with pytest.raises(ValueError, match="at most once"):
         MonitorConfig(locations=[{"name": "glovebox", "point_m": (0.6, -0.9, -0.6)}] * 2)  # type: ignore[list-item]
+
+
+def test_each_phone_row_looks_at_a_phone_off_the_road_where_the_long_distraction_runs() -> None:
+    """Rows 51-61 (`PHONE_LOOKS`): each is a 4 s look at the phone by the head or the eyes; the
+    phone's direction from the driving place lies off the road in a zone that is not driving-
+    related (so the long distraction runs), in both cabins."""
+    from roadgaze.cabin import LOCATIONS
+    from roadgaze.conformance.dossier_rows import ROWS
+    from roadgaze.conformance.locations import PHONE_LOOKS
+    from roadgaze.monitor.zones import ZoneMap
+
+    rows = {row.row: row for row in ROWS}
+    for row, (movement, name) in enumerate(PHONE_LOOKS, 51):
+        assert rows[row].movement.lower() == movement
+        assert rows[row].location == location(name).sheet
+        assert rows[row].cells[0] == (f"{movement}_{name}_70.warns",)
+    phones = {name for _, name in PHONE_LOOKS}
+    assert phones == {loc.name for loc in LOCATIONS[-6:]}
+    for config in (LHD, RHD):
+        zones = ZoneMap.from_config(config)
+        for name in phones:
+            yaw, pitch = location(name, config.cabin).direction_deg()
+            zone = zones.classify(yaw, pitch, None)
+            assert zone != "road" and not zones.is_driving_related(zone), (name, zone)
+    names = {s.name for s in scenario_matrix(LHD)}
+    assert {f"{movement}_{name}_70" for movement, name in PHONE_LOOKS} <= names
+
+
+@pytest.mark.slow
+def test_a_look_at_the_phone_in_the_lap_warns_and_raises_support_through_the_service(
+    tmp_path: Path,
+) -> None:
+    """Through the real service: the head down to the phone in the lap (row 53) and the eyes
+    down to a phone at the wheel's centre (row 60) warn within the long distraction's window
+    and raise support within 0.5 s (measured 3.20 s and 3.13 s; support 0.20 s and 0.13 s)."""
+    import json
+
+    from roadgaze.cli import main
+
+    only = ["--only", "owl_driver_lap_70", "--only", "lizard_phone_wheel_centre_70"]
+    code = main(["conformance", "--protocol", "euroncap", *only, "--out", str(tmp_path)])
+    results = json.loads((tmp_path / "conformance.json").read_text(encoding="utf-8"))
+    outcomes = {r["requirement"]: r for r in results["outcomes"]}
+    assert len(outcomes) == 6 and {r["result"] for r in outcomes.values()} == {"PASS"}
+    assert code == 0
+    for scenario in ("owl_driver_lap_70", "lizard_phone_wheel_centre_70"):
+        assert 3.0 <= outcomes[f"{scenario}.warns"]["measured_s"] <= 3.6
+        assert outcomes[f"{scenario}.support_forward"]["measured_s"] <= 0.5

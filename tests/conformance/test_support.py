@@ -6,7 +6,12 @@ import pytest
 
 from roadgaze.config import MonitorConfig
 from roadgaze.conformance.matrix import scenario_matrix
-from roadgaze.conformance.support import SUPPORTED, judge_support, support_requirements
+from roadgaze.conformance.support import (
+    AFTER_WARNING,
+    SUPPORTED,
+    judge_support,
+    support_requirements,
+)
 
 FORWARD = support_requirements(MonitorConfig(), "look_70", "look", "back")[0]
 
@@ -57,3 +62,50 @@ def test_the_matrix_judges_support_on_the_listed_scenarios_and_two_long_mirror_l
     sleep = [r for r in scenarios["sleep_70"].requirements if r.held_until]
     assert {r.held_until for r in sleep} == {"end"}  # an impairment: to the end of the trip
     assert FORWARD.window_s == (0.0, 0.5)
+
+
+def test_drowsiness_support_counts_from_its_warning_and_may_already_be_heightened() -> None:
+    """Row 68's support follows the drowsiness warning (`AFTER_WARNING`): its clock starts at
+    the first `drowsy` alert, the long blinks before may already have raised it, and it must be
+    held to the end of the trip."""
+    from roadgaze.conformance.run import outcomes_of
+
+    drowsy = {s.name: s for s in scenario_matrix(MonitorConfig(protocol="euroncap"))}["drowsy_70"]
+    support = [r for r in drowsy.requirements if r.held_until]
+    assert [(r.from_alert, r.held_until) for r in support] == [("drowsy", "end")] * 2
+    assert AFTER_WARNING == {"drowsy_70": "drowsy"}
+    end_s = drowsy.duration_s
+
+    def judged(alerts: list[tuple[str, str, float]]) -> dict[str, tuple[float | None, bool]]:
+        outcomes = outcomes_of(drowsy, alerts)
+        return {o.requirement.key.rpartition(".")[2]: (o.measured_s, o.passed) for o in outcomes}
+
+    raised_by_a_blink = [
+        ("support_forward", "normal", 0.0),
+        ("support_lane", "normal", 0.0),
+        ("support_forward", "heightened", 5.1),  # a long blink, before the warning
+        ("support_lane", "heightened", 5.1),
+        ("drowsy", "warning", 12.3),
+    ]
+    got = judged(raised_by_a_blink)
+    assert got["warns"][1] and got["support_forward"] == (0.0, True)
+    assert got["support_lane"] == (0.0, True)
+    late = judged(
+        [
+            *raised_by_a_blink[:2],
+            ("drowsy", "warning", 12.3),
+            ("support_forward", "heightened", 12.9),  # 0.6 s after the warning: too late
+            ("support_lane", "heightened", 12.5),
+        ]
+    )
+    assert late["support_forward"] == (pytest.approx(0.6), False)
+    assert late["support_lane"] == (pytest.approx(0.2), True)
+    dropped = judged([*raised_by_a_blink, ("support_lane", "normal", end_s - 1.0)])
+    assert dropped["support_lane"][1] is False and dropped["support_forward"][1] is True
+    assert judged(raised_by_a_blink[:4])["support_forward"] == (None, False)  # never warned
+
+
+def test_support_after_a_warning_counts_an_output_already_heightened() -> None:
+    changes = [("support_forward", "normal", 1.0), ("support_forward", "heightened", 2.0)]
+    assert judge_support(FORWARD, 3.0, 7.0, changes) == (0.0, False)  # a glance's: not its own
+    assert judge_support(FORWARD, 3.0, 7.0, changes, from_normal=False) == (0.0, True)

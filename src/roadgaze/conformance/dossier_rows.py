@@ -145,20 +145,52 @@ _SHORT_ROWS = (
     _row(47, SHORT, "Multi-target", "Lizard", "", VATS, _vats("lizard_multi_target")),
 )
 BASIC, ADVANCED = "Basic phone use", "Advanced phone use"
+_DASH, _MOUNT, _KNEE, _HUB = (
+    "phone_dashboard_outboard",
+    "phone_dedicated_mount",
+    "driver_knee_outboard",
+    "phone_wheel_centre",
+)
+
+
+def _look(movement: str, place: str) -> tuple[str, ...]:
+    """A phone row's warning evidence: a 4 s look at the phone by `movement` warns."""
+    return (f"{movement}_{place}_70.warns",)
+
+
 _PHONE_USE = (euroncap.PHONE_USE,)
 _WHEEL, _SCREEN = ("phone_wheel_70.warns",), ("phone_windscreen_70.warns",)
 _PHONE_ROWS = (
-    _row(51, PHONE, BASIC, "Owl", "Phone mounted on dashboard outboard", ()),
-    _row(52, PHONE, BASIC, "Owl", "Driver knee outboard", ()),
-    _row(53, PHONE, BASIC, "Owl", "Driver lap", ()),
-    _row(54, PHONE, BASIC, "Owl", "Driver inboard", ()),
-    _row(55, PHONE, BASIC, "Owl", "Phone mounted on dedicated position", ()),
-    _row(56, PHONE, BASIC, "Lizard", "Driver knee outboard", ()),
-    _row(57, PHONE, BASIC, "Lizard", "Driver lap", ()),
-    _row(58, PHONE, BASIC, "Lizard", "Driver inboard", ()),
-    _row(59, PHONE, BASIC, "Lizard", "Phone mounted on dedicated position", ()),
-    _row(60, PHONE, BASIC, "Lizard", "Phone held centre of steering wheel", ()),
-    _row(61, PHONE, ADVANCED, "Lizard", "Phone mounted on dashboard outboard", ()),
+    # A look at the phone where it lies (roadgaze.conformance.locations.PHONE_LOOKS).
+    _row(51, PHONE, BASIC, "Owl", "Phone mounted on dashboard outboard", LD, _look("owl", _DASH)),
+    _row(52, PHONE, BASIC, "Owl", "Driver knee outboard", LD, _look("owl", "driver_knee_outboard")),
+    _row(53, PHONE, BASIC, "Owl", "Driver lap", LD, _look("owl", "driver_lap")),
+    _row(54, PHONE, BASIC, "Owl", "Driver inboard", LD, _look("owl", "driver_inboard")),
+    _row(55, PHONE, BASIC, "Owl", "Phone mounted on dedicated position", LD, _look("owl", _MOUNT)),
+    _row(56, PHONE, BASIC, "Lizard", "Driver knee outboard", LD, _look("lizard", _KNEE)),
+    _row(57, PHONE, BASIC, "Lizard", "Driver lap", LD, _look("lizard", "driver_lap")),
+    _row(58, PHONE, BASIC, "Lizard", "Driver inboard", LD, _look("lizard", "driver_inboard")),
+    _row(
+        59,
+        PHONE,
+        BASIC,
+        "Lizard",
+        "Phone mounted on dedicated position",
+        LD,
+        _look("lizard", _MOUNT),
+    ),
+    _row(
+        60, PHONE, BASIC, "Lizard", "Phone held centre of steering wheel", LD, _look("lizard", _HUB)
+    ),
+    _row(
+        61,
+        PHONE,
+        ADVANCED,
+        "Lizard",
+        "Phone mounted on dashboard outboard",
+        LD,
+        _look("lizard", _DASH),
+    ),
     # A phone held up (roadgaze.conformance.phone): the hand seen, the eyes on the phone.
     _row(62, PHONE, ADVANCED, "Lizard", "Phone held in 9-11 or 1-3 o'clock", _PHONE_USE, _WHEEL),
     _row(63, PHONE, ADVANCED, "Lizard", "Phone held in view of windscreen", _PHONE_USE, _SCREEN),

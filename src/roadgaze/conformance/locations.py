@@ -30,7 +30,15 @@ from roadgaze.conformance.matrix import (
 from roadgaze.conformance.model import Scenario, Segment
 from roadgaze.monitor.protocols import euroncap
 
-__all__ = ["EYE_REACH_DEG", "LEANS_M", "LEAN_ZOOM", "location_scenarios", "look_at"]
+__all__ = [
+    "EYE_REACH_DEG",
+    "LEANS_M",
+    "LEAN_ZOOM",
+    "PHONE_LOOKS",
+    "location_scenarios",
+    "look_at",
+    "phone_look_scenarios",
+]
 
 EYE_REACH_DEG = 35.0
 """How far a lizard look moves the eyes in the head, each way (the renderer's eyes reach 35)."""
@@ -78,9 +86,11 @@ def look_at(
     return Segment(duration_s, head_yaw, head_pitch, label=label, lean_m=lean)
 
 
-def _long(config: MonitorConfig, name: str, movement: str, mounting: str = "front") -> Scenario:
+def _long(
+    config: MonitorConfig, name: str, movement: str, mounting: str = "front", what: str = ""
+) -> Scenario:
     scenario = f"{movement}_{name}_70"
-    what = f"4 s {movement} look at the {name.replace('_', ' ')} at 70 km/h"
+    what = what or f"4 s {movement} look at the {name.replace('_', ' ')} at 70 km/h"
     if movement == "lean":
         what = f"4 s body lean toward the {name.replace('_', ' ')} at 70 km/h"
     if mounting != "front":
@@ -123,6 +133,35 @@ def _short(
 
 MULTI_TARGET = ("infotainment", "passenger_footwell", "glovebox")
 """The multi-target lizard pattern: eyes-only glances at several locations in turn."""
+
+
+PHONE_LOOKS: tuple[tuple[str, str], ...] = (
+    ("owl", "phone_dashboard_outboard"),
+    ("owl", "driver_knee_outboard"),
+    ("owl", "driver_lap"),
+    ("owl", "driver_inboard"),
+    ("owl", "phone_dedicated_mount"),
+    ("lizard", "driver_knee_outboard"),
+    ("lizard", "driver_lap"),
+    ("lizard", "driver_inboard"),
+    ("lizard", "phone_dedicated_mount"),
+    ("lizard", "phone_wheel_centre"),
+    ("lizard", "phone_dashboard_outboard"),
+)
+"""The phone-use rows measured by a look at the phone (sheet rows 51-61, in order): basic phone
+use by the head (owl) and by the eyes (lizard), and advanced phone use at the dashboard mount."""
+
+
+def phone_look_scenarios(config: MonitorConfig) -> list[Scenario]:
+    """A 4 s look at the phone at each of `PHONE_LOOKS` at 70 km/h: the eyes leave the road for
+    the phone, so the long-distraction rule warns (the phone itself is not drawn: lying in the
+    lap or mounted low, it is outside a driver camera's picture, and no rule needs to see it)."""
+    scenarios = []
+    for movement, name in PHONE_LOOKS:
+        sheet = location(name).sheet
+        what = f"4 s {movement} look at a phone ({sheet.lower()}) at 70 km/h"
+        scenarios.append(_long(config, name, movement, what=what))
+    return scenarios
 
 
 def location_scenarios(config: MonitorConfig) -> list[Scenario]:

@@ -233,7 +233,7 @@ def preset_scenarios(config: MonitorConfig) -> list[Scenario]:
 def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
     """Every scenario, in report order."""
     from roadgaze.conformance.drowsiness import drowsiness_scenarios
-    from roadgaze.conformance.locations import location_scenarios
+    from roadgaze.conformance.locations import location_scenarios, phone_look_scenarios
     from roadgaze.conformance.notices import notice_scenarios
     from roadgaze.conformance.phone import phone_scenarios
     from roadgaze.conformance.support import support_scenarios, with_support
@@ -250,7 +250,8 @@ def scenario_matrix(config: MonitorConfig) -> list[Scenario]:
         *drowsiness_scenarios(config),
         # The non-functional notices (Euro NCAP general requirements).
         *notice_scenarios(config),
-        # Advanced phone use: a phone held up (roadgaze.conformance.phone).
+        # Phone use: a look at the phone where it lies (basic), a phone held up (advanced).
+        *phone_look_scenarios(config),
         *phone_scenarios(config),
     ]
     # Forward and lane support: judged on the scenarios of roadgaze.conformance.support.SUPPORTED,

@@ -68,6 +68,11 @@ class Requirement:
     the end of the drive); '' for an alert requirement. A support requirement measures the
     first change to `heightened` at or after the start, and passes only when the output was
     `normal` just before the start (roadgaze.conformance.support)."""
+    from_alert: str = ""
+    """For a support requirement that follows a warning (drowsiness): its clock starts at the
+    first alert of this kind instead of `from_label` and is held to the end of the drive; the
+    output may already be heightened then (raised earlier by the same driver's closures); no
+    such alert: not met."""
 
 
 @dataclass(frozen=True, slots=True)

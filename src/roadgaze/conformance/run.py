@@ -73,13 +73,21 @@ def outcomes_of(scenario: Scenario, alerts: Alerts) -> list[Outcome]:
     )
     results = []
     for requirement in scenario.requirements:
-        start_s = scenario.start_of(requirement.from_label)
-        if requirement.held_until:
+        if requirement.from_alert:
+            warned = [t_s for kind, _, t_s in alerts if kind == requirement.from_alert]
+            until_s = scenario.duration_s
+            measured, passed = (
+                judge_support(requirement, min(warned), until_s, alerts, from_normal=False)
+                if warned
+                else (None, False)
+            )
+        elif requirement.held_until:
             until = requirement.held_until
             until_s = scenario.duration_s if until == "end" else scenario.start_of(until)
+            start_s = scenario.start_of(requirement.from_label)
             measured, passed = judge_support(requirement, start_s, until_s, alerts)
         else:
-            measured, passed = judge(requirement, start_s, alerts)
+            measured, passed = judge(requirement, scenario.start_of(requirement.from_label), alerts)
         results.append(Outcome(scenario.name, requirement, measured, passed, shown))
     return results
 

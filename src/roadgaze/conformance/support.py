@@ -16,12 +16,14 @@ from dataclasses import replace
 from roadgaze.config import MonitorConfig
 from roadgaze.config.support import SUPPORT_RAISE_MAX_S
 from roadgaze.conformance.driving_task import DRIVING_TASK_ROWS, driving_task_scenarios
+from roadgaze.conformance.locations import PHONE_LOOKS
 from roadgaze.conformance.model import Requirement, Scenario, Segment
 from roadgaze.monitor.behaviours.support import HEIGHTENED, NORMAL, output_name
 from roadgaze.monitor.protocols.support import CHANNELS, support_rules
 from roadgaze.types import FrameRecord, Verdict
 
 __all__ = [
+    "AFTER_WARNING",
     "SHEET_ROWS",
     "SUPPORTED",
     "SUPPORT_OUTPUTS",
@@ -56,9 +58,15 @@ SUPPORTED: dict[str, tuple[str, str]] = {
     "vats_lizard_infotainment_70": ("look", "glance1"),
     "vats_lizard_passenger_footwell_70": ("look", "glance1"),
     "vats_lizard_multi_target_70": ("look", "glance1"),
-}
+} | {f"{movement}_{name}_70": ("look", "back") for movement, name in PHONE_LOOKS}
 """Scenarios of the matrix whose support is judged: (the label its clock starts at, the label
-until which support must hold; `end`: the end of the drive, after an impairment)."""
+until which support must hold; `end`: the end of the drive, after an impairment). The looks at
+a phone (roadgaze.conformance.locations.PHONE_LOOKS) too."""
+
+AFTER_WARNING: dict[str, str] = {"drowsy_70": "drowsy"}
+"""Scenarios whose support follows a warning, not a look: it must be heightened within the
+bound of the first alert of this kind and held to the end of the trip (drowsiness: the
+driver's long blinks may have raised it before, as closures)."""
 
 
 class SupportLog:
@@ -79,16 +87,17 @@ class SupportLog:
 
 
 def support_requirements(
-    config: MonitorConfig, scenario: str, from_label: str, held_until: str
+    config: MonitorConfig, scenario: str, from_label: str, held_until: str, from_alert: str = ""
 ) -> tuple[Requirement, ...]:
-    """Forward and lane support raised within the bound of the labelled start, held until
-    `held_until`."""
+    """Forward and lane support raised within the bound of the labelled start (or of the first
+    `from_alert` alert), held until `held_until`."""
     requirements = []
     for channel in CHANNELS:
         rules = support_rules(channel)
         rule = rules.impaired if held_until == "end" else rules.off_road
         held = "to the end of the trip" if held_until == "end" else f"until {held_until}"
-        text = f"{channel} support heightened within {SUPPORT_RAISE_MAX_S:g} s, held {held}"
+        since = f" of the {from_alert} warning" if from_alert else ""
+        text = f"{channel} support heightened within {SUPPORT_RAISE_MAX_S:g} s{since}, held {held}"
         source = f"{rule.key}: {rule.source}"
         window = (0.0, SUPPORT_RAISE_MAX_S)
         requirements.append(
@@ -100,6 +109,7 @@ def support_requirements(
                 window,
                 from_label,
                 held_until=held_until,
+                from_alert=from_alert,
             )
         )
     return tuple(requirements)
@@ -124,8 +134,10 @@ SHEET_ROWS: dict[int, str] = {
     39: "mirror_{driver}_70",
     41: "mirror_{passenger}_70",
     47: "vats_lizard_multi_target_70",
+    **{row: f"{movement}_{name}_70" for row, (movement, name) in enumerate(PHONE_LOOKS, 51)},
     62: "phone_wheel_70",
     63: "phone_windscreen_70",
+    68: "drowsy_70",
     70: "microsleep_70",
     71: "sleep_70",
 } | {row: look.scenario for row, look in DRIVING_TASK_ROWS.items()}
@@ -139,8 +151,12 @@ def with_support(config: MonitorConfig, scenarios: list[Scenario]) -> list[Scena
     added = []
     for scenario in scenarios:
         labels = SUPPORTED.get(scenario.name)
+        warning = AFTER_WARNING.get(scenario.name)
         if labels is not None:
             extra = support_requirements(config, scenario.name, *labels)
+            scenario = replace(scenario, requirements=(*scenario.requirements, *extra))
+        elif warning is not None:
+            extra = support_requirements(config, scenario.name, "event", "end", warning)
             scenario = replace(scenario, requirements=(*scenario.requirements, *extra))
         added.append(scenario)
     return added
@@ -167,18 +183,22 @@ def judge_support(
     start_s: float,
     until_s: float,
     changes: list[tuple[str, str, float]],
+    from_normal: bool = True,
 ) -> tuple[float | None, bool]:
     """(measured, passed): when the output turned heightened after `start_s` (0 when it already
-    was: then it fails, the raise was not the scenario's), and whether it did so in the window
-    from normal and held until `until_s`."""
+    was), and whether it did so in the window and held until `until_s`. With `from_normal`
+    (a glance's support) an output already heightened at the start fails: the raise was not
+    the scenario's; without (support that follows a warning) it counts from the start."""
     mine = [(level, t_s) for name, level, t_s in changes if name in requirement.kinds]
     before = [level for level, t_s in mine if t_s < start_s - 1e-9]
     was_normal = bool(before) and before[-1] == NORMAL
     raised = [t_s for level, t_s in mine if level == HEIGHTENED and t_s >= start_s - 1e-9]
+    if not from_normal and before and before[-1] == HEIGHTENED:
+        raised = [start_s]
     if not raised:
         return (0.0 if not was_normal and before else None), False
     measured = raised[0] - start_s
     dropped = [t_s for level, t_s in mine if level == NORMAL and raised[0] < t_s < until_s - 1e-9]
     window = requirement.window_s or (0.0, SUPPORT_RAISE_MAX_S)
     in_window = window[0] - 1e-9 <= measured <= window[1] + 1e-9
-    return measured, was_normal and in_window and not dropped
+    return measured, (was_normal or not from_normal) and in_window and not dropped

@@ -39,9 +39,10 @@ def test_without_the_pinned_calculator_one_line_says_how_to_install_it(
 def test_the_calculator_pays_the_rows_whose_tests_pass_again(tmp_path: Path) -> None:
     """Every scenario passing and the gates taken as met: the long and short distraction groups
     whose every cell is GREEN (owl, lizard, body lean: warning, forward and lane support; the
-    driving-task glances: forward and lane support), basic phone use, drowsiness, microsleep and
-    sleep (warning, forward and lane support) and the unresponsive driver's emergency function:
-    20.5 points, each selected test answered PASS;
+    driving-task glances: forward and lane support), basic and advanced phone use, drowsiness,
+    microsleep and sleep (warning, forward and lane support) and the unresponsive driver's
+    emergency function: 23.0 points (non-fatigue impairment is RED), each selected test answered
+    PASS;
     a sleep test failing when run again takes its points. The calculator draws the distraction
     tests at random: only the fixed ones are named."""
     pytest.importorskip("euroncap_rating_2026", reason="needs roadgaze[euroncap]")
@@ -56,15 +57,15 @@ def test_the_calculator_pays_the_rows_whose_tests_pass_again(tmp_path: Path) -> 
     assert categories == {
         "Transient - Long distraction": 5.0,  # non-driving and driving-task glances, all cells
         "Transient - Short distraction": 5.0,
-        # basic phone use by the head and the eyes (rows 51-60, one group: 1.25, 1.0, 0.25);
-        # advanced phone use waits on row 64 (held in view of the cluster: no scenario)
-        "Transient - Phone use": 2.5,
+        # basic phone use by the head and the eyes (rows 51-60, one group: 1.25, 1.0, 0.25),
+        # advanced phone use (61-64) likewise
+        "Transient - Phone use": 5.0,
         "Non-transient - Impairment": 2.0,  # drowsiness' warning and support; non-fatigue RED
         "Non-transient - Microsleep": 2.0,
         "Non-transient - Sleep": 2.0,
         "Non-transient - Unresponsive": 2.0,
     }
-    assert passed.score.points == 20.5 and passed.score.max_points == 25.0
+    assert passed.score.points == 23.0 and passed.score.max_points == 25.0
     answers = {(a.column, a.row, a.value) for a in passed.answers}
     assert {("D", 70, "PASS"), ("D", 71, "PASS"), ("F", 72, "PASS")} <= answers
     assert all(value == "PASS" for _, _, value in answers)

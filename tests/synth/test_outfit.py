@@ -46,7 +46,7 @@ def worn(renderer: EyeRenderer, name: str, yaw: float = 0.0, pitch: float = 0.0)
 
 def test_every_condition_is_known_and_an_unknown_one_is_one_line() -> None:
     assert set(WORN) <= set(CONDITIONS)
-    placed = {"night", "talking", "hand_at_12", "phone_wheel", "phone_windscreen"}
+    placed = {"night", "talking", "hand_at_12", "phone_wheel", "phone_windscreen", "phone_cluster"}
     assert placed == set(CONDITIONS) - set(WORN)
     with pytest.raises(ConfigError, match="unknown condition hood; expected any of night,"):
         check_conditions(("mask", "hood"))

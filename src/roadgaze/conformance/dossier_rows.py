@@ -193,6 +193,7 @@ def _look(movement: str, place: str) -> tuple[str, ...]:
 
 _PHONE_USE = (euroncap.PHONE_USE,)
 _WHEEL, _SCREEN = ("phone_wheel_70.warns",), ("phone_windscreen_70.warns",)
+_CLUSTER = ("phone_cluster_70.warns",)
 _PHONE_ROWS = (
     # A look at the phone where it lies (roadgaze.conformance.locations.PHONE_LOOKS).
     _row(51, PHONE, BASIC, "Owl", "Phone mounted on dashboard outboard", LD, _look("owl", _DASH)),
@@ -227,7 +228,15 @@ _PHONE_ROWS = (
     # A phone held up (roadgaze.conformance.phone): the hand seen, the eyes on the phone.
     _row(62, PHONE, ADVANCED, "Lizard", "Phone held in 9-11 or 1-3 o'clock", _PHONE_USE, _WHEEL),
     _row(63, PHONE, ADVANCED, "Lizard", "Phone held in view of windscreen", _PHONE_USE, _SCREEN),
-    _row(64, PHONE, ADVANCED, "Lizard", "Phone held in view of instrument cluster", ()),
+    _row(
+        64,
+        PHONE,
+        ADVANCED,
+        "Lizard",
+        "Phone held in view of instrument cluster",
+        _PHONE_USE,
+        _CLUSTER,
+    ),
 )
 # Drowsiness (impairment by fatigue): roadgaze.conformance.drowsiness.
 DROWSINESS = (euroncap.DROWSINESS, euroncap.DROWSINESS_SPEED)

@@ -6,8 +6,9 @@ forward and lane support by then (earlier is as good: the eyes on the phone may 
 the road).
 
 The phone is held at the wheel (9-11 o'clock in a left-hand-drive cabin, 1-3 in a right-hand-
-drive one) or higher, beside the face in view of the windscreen (`roadgaze.synth.phone_hand`),
-seen through a wider lens (`PHONE_ZOOM`) so the hand at the wheel is in the picture.
+drive one), higher, beside the face in view of the windscreen, or low over the wheel's centre in
+view of the instrument cluster (`roadgaze.synth.phone_hand`), seen through a wider lens
+(`PHONE_ZOOM`) so the hand at the wheel is in the picture.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ KINDS = ("phone_use",)
 PLACES = {
     "wheel": ("a phone held up at the wheel", (15.0, -20.0)),
     "windscreen": ("a phone held up in view of the windscreen", (12.0, -8.0)),
+    "cluster": ("a phone held up in view of the instrument cluster", (4.0, -18.0)),
 }
 """Each place the phone is held (`roadgaze.synth.phone_hand.PLACES`), what it is and the eyes'
 look at it, the head still (the sheet's "lizard"): eye-in-head yaw toward the outer hand and

@@ -137,6 +137,7 @@ SHEET_ROWS: dict[int, str] = {
     **{row: f"{movement}_{name}_70" for row, (movement, name) in enumerate(PHONE_LOOKS, 51)},
     62: "phone_wheel_70",
     63: "phone_windscreen_70",
+    64: "phone_cluster_70",
     68: "drowsy_70",
     70: "microsleep_70",
     71: "sleep_70",

@@ -3,8 +3,8 @@
 A condition is one of `CONDITIONS`. Worn ones dress the face (`Outfit`): paint on the skin under
 the eyes or over them (`roadgaze.synth.layers`) and things drawn on each frame from the turned
 mesh (glasses, a cap, a beard's hanging part). `hand_at_12` is placed by camera mounting
-(`roadgaze.synth.occluders`), a phone held up (`phone_wheel`, `phone_windscreen`) from the
-eyes (`roadgaze.synth.phone_hand`), `night` changes the whole picture
+(`roadgaze.synth.occluders`), a phone held up (`phone_wheel`, `phone_windscreen`,
+`phone_cluster`) from the eyes (`roadgaze.synth.phone_hand`), `night` changes the whole picture
 (`roadgaze.synth.effects.night`) and `talking` moves the jaw
 (`roadgaze.synth.mouth.speech_track`); the conformance scenarios apply those
 (`roadgaze.conformance.clips`). Everything is seeded: the same driver wears
@@ -95,6 +95,8 @@ CONDITIONS: dict[str, str] = {
     "hand_at_12": "a hand gripping the top of the wheel, between the camera and the face",
     "phone_wheel": "a phone held up in the outer hand at the wheel (9-11 or 1-3 o'clock)",
     "phone_windscreen": "a phone held up in the outer hand beside the face, in view of the road",
+    "phone_cluster": "a phone held up in the outer hand over the wheel's centre, in front of the "
+    "instrument cluster",
 }
 """Every condition a scenario can render, with what it shows."""
 SEED = 11

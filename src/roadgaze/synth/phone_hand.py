@@ -13,7 +13,9 @@ dossier's advanced phone rows hold it, in face widths W from the eyes with the h
 road, drawn `SCALE` times its size next to the face (nearer the camera):
 
 - `wheel` (9-11 o'clock): the hand lifted just off the rim (drawn behind it), the phone beside
-  the chin; `windscreen`: higher, the phone beside the eyes, in view of the road.
+  the chin; `windscreen`: higher, the phone beside the eyes, in view of the road; `cluster`:
+  lower and nearer the middle, the phone over the wheel's centre in front of the instrument
+  cluster.
 
 The parts are painted far to near (the rim, the phone, the forearm in its sleeve, the back of
 the hand, the fingers from the little one to the index, the thumb), each skin part shaded as a
@@ -100,6 +102,7 @@ class HandPlace:
 PLACES: dict[str, HandPlace] = {
     "wheel": HandPlace(2.6, 1.35, 10.0, on_rim=True),
     "windscreen": HandPlace(1.9, 1.3, 10.0),
+    "cluster": HandPlace(2.7, 1.05, 0.0),
 }
 
 

@@ -134,3 +134,25 @@ def test_cli_demo_rejects_a_bad_timeline(tmp_path: Path, subprocess_env: dict[st
         "roadgaze demo: error: timeline keyframe 'far:2': yaw 'far' is not a number "
         "(expected YAW[/PITCH]:SECONDS, e.g. 40:3.5 or 30/-10:2)"
     ]
+
+
+def test_the_demo_fetches_missing_hand_models_unless_downloads_are_off(tmp_path: Path) -> None:
+    """A first run on a fresh machine shows the whole service: the demo fetches the hand models
+    (the daemon never does); with downloads off it leaves the cache alone."""
+    from roadgaze.config.settings import ModelConfig
+    from roadgaze.demo import fetch_hand_models_for_demo
+    from roadgaze.landmarks.hands.models import MODEL_FILES, find_hand_models
+
+    said: list[str] = []
+    off = Config(model=ModelConfig(cache_dir=tmp_path / "off", allow_download=False))
+    fetch_hand_models_for_demo(off, said.append)
+    assert said == [] and not (tmp_path / "off").exists()
+    on = Config(model=ModelConfig(cache_dir=tmp_path / "on"))
+    fetch_hand_models_for_demo(on, said.append)
+    found, missing = find_hand_models(on.model, tuple(MODEL_FILES))
+    if missing:
+        pytest.skip(f"hand models could not be fetched here: {missing}")
+    assert said == ["fetching the hand models (roadgaze model fetch hands)"]
+    assert sorted(found) == sorted(MODEL_FILES)
+    fetch_hand_models_for_demo(on, said.append)  # all there: nothing more to fetch
+    assert len(said) == 1

@@ -169,6 +169,26 @@ def format_alert(message: dict[str, Any]) -> str:
     )
 
 
+def fetch_hand_models_for_demo(config: Config, progress: Callable[[str], None]) -> None:
+    """The demo is a first run on a fresh machine: it fetches the hand models (as `roadgaze model
+    fetch hands`) so that it shows the whole service. The daemon never downloads them at start-up
+    (docs/phone.md); where they cannot be had, the demo runs without phone detection and the hand
+    stage says so."""
+    from roadgaze.errors import ModelError
+    from roadgaze.landmarks.hands.models import MODEL_FILES, fetch_hand_models, find_hand_models
+
+    if not (config.hands.enabled and config.model.allow_download):
+        return
+    _, missing = find_hand_models(config.model, tuple(MODEL_FILES))
+    if not missing:
+        return
+    progress("fetching the hand models (roadgaze model fetch hands)")
+    try:
+        fetch_hand_models(config.model)
+    except ModelError as exc:
+        log.info("the demo runs without phone detection: %s", exc)
+
+
 def run_demo(
     out_dir: Path,
     config: Config | None = None,
@@ -208,6 +228,7 @@ def run_demo(
     truth_path_for(video_path).unlink(missing_ok=True)
     rendered = time.perf_counter()
 
+    fetch_hand_models_for_demo(config, progress)
     port = free_local_port()
     config = demo_config(config, port)
     plot_path = out_dir / PLOT_NAME

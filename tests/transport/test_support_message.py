@@ -128,6 +128,11 @@ def test_a_zenoh_subscriber_receives_support_and_the_state_carries_it() -> None:
             health = Health(config, keys, link, "test-source")
             health_holder.append(health)
             assert wait_for(lambda: link.status().connected)
+            # The router's subscriber reaches the link's support publisher a little after the
+            # link is up; a put before that is not routed (one CI run lost the first frames).
+            declared = link._declared
+            assert declared is not None
+            assert wait_for(lambda: declared.support.matching_status.matching, timeout_s=10.0)
             publisher = BusPublisher(keys.vehicle_id, link)
             pipeline = Pipeline.from_config(config, ScriptedDetector([40.0] * 5))
             pipeline.run(ListSource(5), [health, publisher])

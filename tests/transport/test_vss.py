@@ -231,6 +231,12 @@ def test_vss_values_reach_a_zenoh_subscriber_with_kuksas_attachment() -> None:
         subscriber = hub.declare_subscriber("Vehicle/**", on_sample)
         with ZenohLink(config.zenoh, keys, vss_keys=vss_keys) as link:
             assert wait_for(lambda: link.status().connected)
+            # The router's subscriber reaches the link's publishers a little after the link is
+            # up; a put before that is not routed.
+            declared = link._declared
+            assert declared is not None
+            publishers = list(declared.vss.values())
+            assert wait_for(lambda: all(p.matching_status.matching for p in publishers), 10.0)
             publisher = VssPublisher(link, config.monitor)
             for record in drive([(1.0, 0.0, eyes_of())]):
                 publisher.on_record(record, BLANK_FRAME)

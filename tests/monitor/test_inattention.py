@@ -446,8 +446,12 @@ def test_mirror_glances_count_for_vats() -> None:
     [
         # mirror 1 s, then away: the timer starts with the away part and fires 3 s into it
         (((1.0, ROAD_POSE), (1.0, LEFT_MIRROR), (5.0, AWAY_POSE)), 1.0 + 1.0 + 3.0),
-        # away 2 s, mirror 1.5 s (pauses, does not reset), away again: 1 s more
-        (((1.0, ROAD_POSE), (2.0, AWAY_POSE), (1.5, LEFT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 4.5),
+        # away 0.4 s (a turn passing the road's edge), mirror 1.5 s (pauses, does not reset),
+        # away again: 2.6 s more
+        (((1.0, ROAD_POSE), (0.4, AWAY_POSE), (1.5, LEFT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 4.5),
+        # away 2 s, then a mirror reading: after a look elsewhere (driving_glance_entry_s,
+        # 0.5 s) a mirror stay no longer pauses the timer, which fires 1 s into it
+        (((1.0, ROAD_POSE), (2.0, AWAY_POSE), (1.5, LEFT_MIRROR), (3.0, AWAY_POSE)), 1.0 + 3.0),
         # mirror 1.5 s then away 2 s: 2 s of distraction, no alert
         (((1.0, ROAD_POSE), (1.5, LEFT_MIRROR), (2.0, AWAY_POSE), (2.0, ROAD_POSE)), None),
         # the lap is not driving-related
@@ -547,3 +551,17 @@ def test_a_turn_held_just_past_the_road_edge_early_in_a_drive_is_not_learned_as_
     assert monitor.state.neutral.yaw_deg > -3.0, monitor.state.neutral.yaw_deg
     kinds = [a.kind for a in alerts]
     assert AlertKind.LONG_DISTRACTION in kinds
+
+
+def test_a_mirror_reading_after_a_look_elsewhere_goes_on_counting() -> None:
+    """`driving_glance_entry_s`: a 70 deg look right read, under a hat's brim, partly as 50 deg
+    (the right mirror's zone) with the face lost between, used to pause at every mirror reading
+    and warned only after the look; the readings after the look began no longer pause it. None
+    keeps every mirror stay paused (before)."""
+    parts = ((1.0, ROAD_POSE), (1.0, AWAY_POSE), (0.6, None), (1.2, RIGHT_MIRROR), (1.2, None))
+    _, alerts, _ = run_poses(segments(*parts, (1.0, ROAD_POSE)), 6.4)
+    assert kinds(alerts)[0] == ("long_distraction", "warning")
+    assert_within_one_frame(alerts[0].t_s, 1.0 + 3.0)
+    every = FIXED.model_copy(update={"driving_glance_entry_s": None})
+    _, before, _ = run_poses(segments(*parts, (1.0, ROAD_POSE)), 6.4, every)
+    assert [a for a in before if a.label == "long_distraction:warning"] == []

@@ -188,6 +188,11 @@ class MonitorConfig(
     """A continuous stay in a driving-related zone this long is a stare, not a glance: it counts as
     distraction from its start (fail-safe: a long look out of the side window is not excused as a
     mirror check); None: never."""
+    driving_glance_entry_s: float | None = Field(default=0.5, gt=0)
+    """A stay in a driving-related zone pauses the long-distraction timer only while the episode
+    has counted less than this outside the road and those zones: a mirror check starts from the
+    road, while a reading in a mirror zone after a look elsewhere (a 70 deg look read as 50 deg,
+    the face lost between) continues that look; None: every stay pauses it."""
     neutral_yaw_deg: float | None = None
     """Fixed road-ahead yaw; None learns it online from on-road samples."""
     neutral_pitch_deg: float | None = None

@@ -8,7 +8,8 @@ are measured once per sample, before the behaviours run (`step_episode`).
   (a driver not seen is not seen on the road; a failed camera is a temporary failure instead),
   while moving. An episode starts at its first counted sample and ends at the first other one.
 - distraction time: the episode's time outside the driving-related zones (`driving_related_zones`,
-  the mirrors: their time pauses it, up to `driving_glance_max_s` per continuous stay when set).
+  the mirrors: their time pauses it, up to `driving_glance_max_s` per continuous stay when set,
+  and only for a stay entered before the episode has counted `driving_glance_entry_s` elsewhere).
 - on road since: the start of the current run of on-road samples with a face.
 - unavailable since: the start of the current run of moving samples whose gaze is unknown.
 """
@@ -141,6 +142,10 @@ def step_episode(
     off_since, last_off_road_s = episode.off_since_s, episode.last_off_road_s
     segment_since, segment_driving = episode.segment_since_s, episode.segment_driving
     before_s, intervals = episode.distraction_before_s, episode.off_intervals
+    entry_s = config.driving_glance_entry_s
+    if driving and not segment_driving and off_since is not None and entry_s is not None:
+        so_far_s = before_s + segment_distraction_s(config, segment_since, t_s, False)
+        driving = so_far_s < entry_s - EPS_S  # entered after a look elsewhere: it goes on
     if counted_off and off_since is None:
         off_since = segment_since = t_s
         segment_driving, before_s = driving, 0.0

@@ -127,11 +127,12 @@ def test_each_phone_row_looks_at_a_phone_off_the_road_where_the_long_distraction
     from roadgaze.monitor.zones import ZoneMap
 
     rows = {row.row: row for row in ROWS}
-    for row, (movement, name) in enumerate(PHONE_LOOKS, 51):
+    assert sorted(PHONE_LOOKS) == list(range(51, 62))
+    for row, (movement, name) in PHONE_LOOKS.items():
         assert rows[row].movement.lower() == movement
         assert rows[row].location == location(name).sheet
         assert rows[row].cells[0] == (f"{movement}_{name}_70.warns",)
-    phones = {name for _, name in PHONE_LOOKS}
+    phones = {name for _, name in PHONE_LOOKS.values()}
     assert phones == {loc.name for loc in LOCATIONS[-6:]}
     for config in (LHD, RHD):
         zones = ZoneMap.from_config(config)
@@ -140,7 +141,7 @@ def test_each_phone_row_looks_at_a_phone_off_the_road_where_the_long_distraction
             zone = zones.classify(yaw, pitch, None)
             assert zone != "road" and not zones.is_driving_related(zone), (name, zone)
     names = {s.name for s in scenario_matrix(LHD)}
-    assert {f"{movement}_{name}_70" for movement, name in PHONE_LOOKS} <= names
+    assert {f"{movement}_{name}_70" for movement, name in PHONE_LOOKS.values()} <= names
 
 
 @pytest.mark.slow

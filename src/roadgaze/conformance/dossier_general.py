@@ -14,7 +14,6 @@ from roadgaze.conformance.notices import notice_key
 DROWSINESS_EVIDENCE = ("drowsy_70.warns", "alert_70.quiet", "drowsy_40.quiet")
 """Drowsiness' warning (row 68) and its activation speed: warned at 70 km/h, silent for an
 alert driver at 70 km/h and for the drowsy one at 40 km/h (roadgaze.conformance.drowsiness)."""
-_DROWSINESS = DROWSINESS_EVIDENCE
 
 Variant = Callable[[Scenario], Scenario]
 
@@ -141,7 +140,7 @@ GENERAL_REQUIREMENTS: tuple[GeneralRequirement, ...] = (
         "Speed activation condition for the impairment driver states, when the vehicle is moving "
         "forward at a speed of at least 50 km/h",
         "speed activation of impairment (>= 50 km/h)",
-        _DROWSINESS,
+        DROWSINESS_EVIDENCE,
         basis="drowsiness warns at 70 km/h and not at 40 km/h (drowsiness_min_speed_kmh 50); "
         "non-fatigue impairment is not detected (its row stays RED)",
     ),

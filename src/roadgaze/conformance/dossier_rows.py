@@ -27,6 +27,7 @@ from roadgaze.conformance.dossier_general import (
     dark_sunglasses,
     under,
 )
+from roadgaze.conformance.locations import PHONE_LOOKS, look_name
 from roadgaze.conformance.support import SHEET_ROWS
 from roadgaze.monitor.protocols import Rule, euroncap, support
 
@@ -178,17 +179,13 @@ _SHORT_ROWS = (
     _row(47, SHORT, "Multi-target", "Lizard", "", VATS, _vats("lizard_multi_target")),
 )
 BASIC, ADVANCED = "Basic phone use", "Advanced phone use"
-_DASH, _MOUNT, _KNEE, _HUB = (
-    "phone_dashboard_outboard",
-    "phone_dedicated_mount",
-    "driver_knee_outboard",
-    "phone_wheel_centre",
-)
 
 
-def _look(movement: str, place: str) -> tuple[str, ...]:
-    """A phone row's warning evidence: a 4 s look at the phone by `movement` warns."""
-    return (f"{movement}_{place}_70.warns",)
+def _phone_look(row: int, task: str, location: str) -> SheetRow:
+    """A phone row measured by a look at the phone (`PHONE_LOOKS`): its warning cell."""
+    movement, place = PHONE_LOOKS[row]
+    warns = (f"{look_name(movement, place)}.warns",)
+    return _row(row, PHONE, task, movement.capitalize(), location, LD, warns)
 
 
 _PHONE_USE = (euroncap.PHONE_USE,)
@@ -196,35 +193,17 @@ _WHEEL, _SCREEN = ("phone_wheel_70.warns",), ("phone_windscreen_70.warns",)
 _CLUSTER = ("phone_cluster_70.warns",)
 _PHONE_ROWS = (
     # A look at the phone where it lies (roadgaze.conformance.locations.PHONE_LOOKS).
-    _row(51, PHONE, BASIC, "Owl", "Phone mounted on dashboard outboard", LD, _look("owl", _DASH)),
-    _row(52, PHONE, BASIC, "Owl", "Driver knee outboard", LD, _look("owl", "driver_knee_outboard")),
-    _row(53, PHONE, BASIC, "Owl", "Driver lap", LD, _look("owl", "driver_lap")),
-    _row(54, PHONE, BASIC, "Owl", "Driver inboard", LD, _look("owl", "driver_inboard")),
-    _row(55, PHONE, BASIC, "Owl", "Phone mounted on dedicated position", LD, _look("owl", _MOUNT)),
-    _row(56, PHONE, BASIC, "Lizard", "Driver knee outboard", LD, _look("lizard", _KNEE)),
-    _row(57, PHONE, BASIC, "Lizard", "Driver lap", LD, _look("lizard", "driver_lap")),
-    _row(58, PHONE, BASIC, "Lizard", "Driver inboard", LD, _look("lizard", "driver_inboard")),
-    _row(
-        59,
-        PHONE,
-        BASIC,
-        "Lizard",
-        "Phone mounted on dedicated position",
-        LD,
-        _look("lizard", _MOUNT),
-    ),
-    _row(
-        60, PHONE, BASIC, "Lizard", "Phone held centre of steering wheel", LD, _look("lizard", _HUB)
-    ),
-    _row(
-        61,
-        PHONE,
-        ADVANCED,
-        "Lizard",
-        "Phone mounted on dashboard outboard",
-        LD,
-        _look("lizard", _DASH),
-    ),
+    _phone_look(51, BASIC, "Phone mounted on dashboard outboard"),
+    _phone_look(52, BASIC, "Driver knee outboard"),
+    _phone_look(53, BASIC, "Driver lap"),
+    _phone_look(54, BASIC, "Driver inboard"),
+    _phone_look(55, BASIC, "Phone mounted on dedicated position"),
+    _phone_look(56, BASIC, "Driver knee outboard"),
+    _phone_look(57, BASIC, "Driver lap"),
+    _phone_look(58, BASIC, "Driver inboard"),
+    _phone_look(59, BASIC, "Phone mounted on dedicated position"),
+    _phone_look(60, BASIC, "Phone held centre of steering wheel"),
+    _phone_look(61, ADVANCED, "Phone mounted on dashboard outboard"),
     # A phone held up (roadgaze.conformance.phone): the hand seen, the eyes on the phone.
     _row(62, PHONE, ADVANCED, "Lizard", "Phone held in 9-11 or 1-3 o'clock", _PHONE_USE, _WHEEL),
     _row(63, PHONE, ADVANCED, "Lizard", "Phone held in view of windscreen", _PHONE_USE, _SCREEN),
@@ -242,9 +221,10 @@ _PHONE_ROWS = (
 DROWSINESS = (euroncap.DROWSINESS, euroncap.DROWSINESS_SPEED)
 _MICROSLEEP = ("microsleep_70.warns", "microsleep_70.no_sleep")
 _UNRESPONSIVE = ("unresponsive_closed_70.warns", "unresponsive_away_70.warns")
-_DROWSINESS = DROWSINESS_EVIDENCE
 _NON_TRANSIENT_ROWS = (
-    _row(68, NON_TRANSIENT, "Impairment", "", "Drowsiness", DROWSINESS, _DROWSINESS, (), NA),
+    _row(
+        68, NON_TRANSIENT, "Impairment", "", "Drowsiness", DROWSINESS, DROWSINESS_EVIDENCE, (), NA
+    ),
     _row(69, NON_TRANSIENT, "Impairment", "", "Non-fatigue", (), (), (), NA),
     _row(70, NON_TRANSIENT, "Microsleep", "", "", (euroncap.MICROSLEEP,), _MICROSLEEP, (), NA),
     _row(71, NON_TRANSIENT, "Sleep", "", "", (euroncap.SLEEP,), ("sleep_70.warns",), (), NA),

@@ -37,6 +37,7 @@ __all__ = [
     "PHONE_LOOKS",
     "location_scenarios",
     "look_at",
+    "look_name",
     "phone_look_scenarios",
 ]
 
@@ -86,10 +87,15 @@ def look_at(
     return Segment(duration_s, head_yaw, head_pitch, label=label, lean_m=lean)
 
 
+def look_name(movement: str, name: str) -> str:
+    """The scenario of a 4 s look by `movement` at location `name` (`owl_driver_lap_70`)."""
+    return f"{movement}_{name}_70"
+
+
 def _long(
     config: MonitorConfig, name: str, movement: str, mounting: str = "front", what: str = ""
 ) -> Scenario:
-    scenario = f"{movement}_{name}_70"
+    scenario = look_name(movement, name)
     what = what or f"4 s {movement} look at the {name.replace('_', ' ')} at 70 km/h"
     if movement == "lean":
         what = f"4 s body lean toward the {name.replace('_', ' ')} at 70 km/h"
@@ -135,21 +141,22 @@ MULTI_TARGET = ("infotainment", "passenger_footwell", "glovebox")
 """The multi-target lizard pattern: eyes-only glances at several locations in turn."""
 
 
-PHONE_LOOKS: tuple[tuple[str, str], ...] = (
-    ("owl", "phone_dashboard_outboard"),
-    ("owl", "driver_knee_outboard"),
-    ("owl", "driver_lap"),
-    ("owl", "driver_inboard"),
-    ("owl", "phone_dedicated_mount"),
-    ("lizard", "driver_knee_outboard"),
-    ("lizard", "driver_lap"),
-    ("lizard", "driver_inboard"),
-    ("lizard", "phone_dedicated_mount"),
-    ("lizard", "phone_wheel_centre"),
-    ("lizard", "phone_dashboard_outboard"),
-)
-"""The phone-use rows measured by a look at the phone (sheet rows 51-61, in order): basic phone
-use by the head (owl) and by the eyes (lizard), and advanced phone use at the dashboard mount."""
+PHONE_LOOKS: dict[int, tuple[str, str]] = {
+    51: ("owl", "phone_dashboard_outboard"),
+    52: ("owl", "driver_knee_outboard"),
+    53: ("owl", "driver_lap"),
+    54: ("owl", "driver_inboard"),
+    55: ("owl", "phone_dedicated_mount"),
+    56: ("lizard", "driver_knee_outboard"),
+    57: ("lizard", "driver_lap"),
+    58: ("lizard", "driver_inboard"),
+    59: ("lizard", "phone_dedicated_mount"),
+    60: ("lizard", "phone_wheel_centre"),
+    61: ("lizard", "phone_dashboard_outboard"),
+}
+"""The phone-use rows measured by a look at the phone, by sheet row: (movement, location); basic
+phone use by the head (owl) and by the eyes (lizard), and advanced phone use at the dashboard
+mount."""
 
 
 def phone_look_scenarios(config: MonitorConfig) -> list[Scenario]:
@@ -157,7 +164,7 @@ def phone_look_scenarios(config: MonitorConfig) -> list[Scenario]:
     the phone, so the long-distraction rule warns (the phone itself is not drawn: lying in the
     lap or mounted low, it is outside a driver camera's picture, and no rule needs to see it)."""
     scenarios = []
-    for movement, name in PHONE_LOOKS:
+    for movement, name in PHONE_LOOKS.values():
         sheet = location(name).sheet
         what = f"4 s {movement} look at a phone ({sheet.lower()}) at 70 km/h"
         scenarios.append(_long(config, name, movement, what=what))

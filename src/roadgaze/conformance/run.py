@@ -17,7 +17,7 @@ from pathlib import Path
 from roadgaze.capture import FrameSource
 from roadgaze.config import Config
 from roadgaze.conformance.clips import CLIP_SUFFIX, RenderedSource, ScenarioRenderer
-from roadgaze.conformance.model import Outcome, Scenario, judge
+from roadgaze.conformance.model import Outcome, Requirement, Scenario, judge
 from roadgaze.conformance.support import SUPPORT_OUTPUTS, SupportLog, judge_support
 from roadgaze.types import Alert, Frame, FrameRecord
 
@@ -66,6 +66,15 @@ def replay_drive(source: FrameSource, track: Path | None, config: Config) -> Ale
     return sink.alerts
 
 
+def clock_start(scenario: Scenario, requirement: Requirement, alerts: Alerts) -> float | None:
+    """When the requirement's clock starts: at its labelled segment, or at the first alert it
+    follows (`from_alert`; None: that alert never came)."""
+    if requirement.from_alert:
+        warned = (t_s for kind, _, t_s in alerts if kind == requirement.from_alert)
+        return min(warned, default=None)
+    return scenario.start_of(requirement.from_label)
+
+
 def outcomes_of(scenario: Scenario, alerts: Alerts) -> list[Outcome]:
     """Each requirement of `scenario` judged on the drive's alerts."""
     shown = tuple(
@@ -73,21 +82,16 @@ def outcomes_of(scenario: Scenario, alerts: Alerts) -> list[Outcome]:
     )
     results = []
     for requirement in scenario.requirements:
-        if requirement.from_alert:
-            warned = [t_s for kind, _, t_s in alerts if kind == requirement.from_alert]
-            until_s = scenario.duration_s
-            measured, passed = (
-                judge_support(requirement, min(warned), until_s, alerts, from_normal=False)
-                if warned
-                else (None, False)
-            )
+        start_s = clock_start(scenario, requirement, alerts)
+        if start_s is None:
+            measured, passed = None, False  # the warning it follows never came
         elif requirement.held_until:
             until = requirement.held_until
             until_s = scenario.duration_s if until == "end" else scenario.start_of(until)
-            start_s = scenario.start_of(requirement.from_label)
-            measured, passed = judge_support(requirement, start_s, until_s, alerts)
+            from_normal = not requirement.from_alert
+            measured, passed = judge_support(requirement, start_s, until_s, alerts, from_normal)
         else:
-            measured, passed = judge(requirement, scenario.start_of(requirement.from_label), alerts)
+            measured, passed = judge(requirement, start_s, alerts)
         results.append(Outcome(scenario.name, requirement, measured, passed, shown))
     return results
 

@@ -16,7 +16,7 @@ from dataclasses import replace
 from roadgaze.config import MonitorConfig
 from roadgaze.config.support import SUPPORT_RAISE_MAX_S
 from roadgaze.conformance.driving_task import DRIVING_TASK_ROWS, driving_task_scenarios
-from roadgaze.conformance.locations import PHONE_LOOKS
+from roadgaze.conformance.locations import PHONE_LOOKS, look_name
 from roadgaze.conformance.model import Requirement, Scenario, Segment
 from roadgaze.monitor.behaviours.support import HEIGHTENED, NORMAL, output_name
 from roadgaze.monitor.protocols.support import CHANNELS, support_rules
@@ -58,7 +58,7 @@ SUPPORTED: dict[str, tuple[str, str]] = {
     "vats_lizard_infotainment_70": ("look", "glance1"),
     "vats_lizard_passenger_footwell_70": ("look", "glance1"),
     "vats_lizard_multi_target_70": ("look", "glance1"),
-} | {f"{movement}_{name}_70": ("look", "back") for movement, name in PHONE_LOOKS}
+} | {look_name(*look): ("look", "back") for look in PHONE_LOOKS.values()}
 """Scenarios of the matrix whose support is judged: (the label its clock starts at, the label
 until which support must hold; `end`: the end of the drive, after an impairment). The looks at
 a phone (roadgaze.conformance.locations.PHONE_LOOKS) too."""
@@ -66,7 +66,8 @@ a phone (roadgaze.conformance.locations.PHONE_LOOKS) too."""
 AFTER_WARNING: dict[str, str] = {"drowsy_70": "drowsy"}
 """Scenarios whose support follows a warning, not a look: it must be heightened within the
 bound of the first alert of this kind and held to the end of the trip (drowsiness: the
-driver's long blinks may have raised it before, as closures)."""
+driver's long blinks may have raised it before, as closures). Their requirements name the
+impaired part's start, the segment labelled `event`."""
 
 
 class SupportLog:
@@ -134,7 +135,7 @@ SHEET_ROWS: dict[int, str] = {
     39: "mirror_{driver}_70",
     41: "mirror_{passenger}_70",
     47: "vats_lizard_multi_target_70",
-    **{row: f"{movement}_{name}_70" for row, (movement, name) in enumerate(PHONE_LOOKS, 51)},
+    **{row: look_name(*look) for row, look in PHONE_LOOKS.items()},
     62: "phone_wheel_70",
     63: "phone_windscreen_70",
     64: "phone_cluster_70",
@@ -151,13 +152,10 @@ def with_support(config: MonitorConfig, scenarios: list[Scenario]) -> list[Scena
     """`scenarios` with the support requirements of those in `SUPPORTED` added."""
     added = []
     for scenario in scenarios:
-        labels = SUPPORTED.get(scenario.name)
-        warning = AFTER_WARNING.get(scenario.name)
+        warning = AFTER_WARNING.get(scenario.name, "")
+        labels = SUPPORTED.get(scenario.name) or (("event", "end") if warning else None)
         if labels is not None:
-            extra = support_requirements(config, scenario.name, *labels)
-            scenario = replace(scenario, requirements=(*scenario.requirements, *extra))
-        elif warning is not None:
-            extra = support_requirements(config, scenario.name, "event", "end", warning)
+            extra = support_requirements(config, scenario.name, *labels, warning)
             scenario = replace(scenario, requirements=(*scenario.requirements, *extra))
         added.append(scenario)
     return added

@@ -67,6 +67,20 @@ def wait_for(predicate: Callable[[], bool], timeout_s: float = 10.0, every_s: fl
     return predicate()
 
 
+def wait_for_subscribers(link: Any, names: tuple[str, ...], timeout_s: float = 10.0) -> bool:
+    """Wait until a subscriber reaches each of the link's publishers `names` (`support`, `vss`:
+    all of its keys; Zenoh's matching status). A router's subscriber reaches them a little after
+    the link is up, and a put before that is not routed."""
+    declared = link._declared
+    if declared is None:
+        return False
+    publishers = []
+    for name in names:
+        entity = getattr(declared, name)
+        publishers += list(entity.values()) if isinstance(entity, dict) else [entity]
+    return wait_for(lambda: all(p.matching_status.matching for p in publishers), timeout_s)
+
+
 class LineReader:
     """Reads a subprocess's stdout lines into a queue on a thread (never blocks the test)."""
 

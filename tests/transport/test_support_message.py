@@ -28,7 +28,7 @@ from roadgaze.transport import (
 )
 from roadgaze.transport.vss import SUPPORT_PATHS, VSS_PATHS, VSS_RANGES, parse_vss_text, vss_text
 from roadgaze.types import FrameRecord, PoseSample
-from zenoh_helpers import client, endpoint, free_port, router, wait_for
+from zenoh_helpers import client, endpoint, free_port, router, wait_for, wait_for_subscribers
 
 FPS = 15.0
 CONFIG = MonitorConfig(neutral_yaw_deg=0.0, neutral_pitch_deg=0.0)
@@ -128,11 +128,7 @@ def test_a_zenoh_subscriber_receives_support_and_the_state_carries_it() -> None:
             health = Health(config, keys, link, "test-source")
             health_holder.append(health)
             assert wait_for(lambda: link.status().connected)
-            # The router's subscriber reaches the link's support publisher a little after the
-            # link is up; a put before that is not routed (one CI run lost the first frames).
-            declared = link._declared
-            assert declared is not None
-            assert wait_for(lambda: declared.support.matching_status.matching, timeout_s=10.0)
+            assert wait_for_subscribers(link, ("support",))  # one CI run lost the first frames
             publisher = BusPublisher(keys.vehicle_id, link)
             pipeline = Pipeline.from_config(config, ScriptedDetector([40.0] * 5))
             pipeline.run(ListSource(5), [health, publisher])

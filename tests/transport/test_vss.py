@@ -27,7 +27,15 @@ from roadgaze.transport import (
 )
 from roadgaze.transport.vss import VSS_PATHS
 from roadgaze.types import EyesFeatures, EyeStatus, EyesVerdict, FrameRecord, PoseSample
-from zenoh_helpers import LineReader, endpoint, free_port, router, stop_process, wait_for
+from zenoh_helpers import (
+    LineReader,
+    endpoint,
+    free_port,
+    router,
+    stop_process,
+    wait_for,
+    wait_for_subscribers,
+)
 
 CONFIG = MonitorConfig(neutral_yaw_deg=5.0, neutral_pitch_deg=-10.0)
 FPS = 30.0
@@ -231,12 +239,7 @@ def test_vss_values_reach_a_zenoh_subscriber_with_kuksas_attachment() -> None:
         subscriber = hub.declare_subscriber("Vehicle/**", on_sample)
         with ZenohLink(config.zenoh, keys, vss_keys=vss_keys) as link:
             assert wait_for(lambda: link.status().connected)
-            # The router's subscriber reaches the link's publishers a little after the link is
-            # up; a put before that is not routed.
-            declared = link._declared
-            assert declared is not None
-            publishers = list(declared.vss.values())
-            assert wait_for(lambda: all(p.matching_status.matching for p in publishers), 10.0)
+            assert wait_for_subscribers(link, ("vss",))
             publisher = VssPublisher(link, config.monitor)
             for record in drive([(1.0, 0.0, eyes_of())]):
                 publisher.on_record(record, BLANK_FRAME)

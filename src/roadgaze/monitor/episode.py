@@ -144,8 +144,8 @@ def step_episode(
     before_s, intervals = episode.distraction_before_s, episode.off_intervals
     entry_s = config.driving_glance_entry_s
     if driving and not segment_driving and off_since is not None and entry_s is not None:
-        so_far_s = before_s + segment_distraction_s(config, segment_since, t_s, False)
-        driving = so_far_s < entry_s - EPS_S  # entered after a look elsewhere: it goes on
+        # entered after a look elsewhere: the look goes on
+        driving = episode.distraction_s(config, t_s) < entry_s - EPS_S
     if counted_off and off_since is None:
         off_since = segment_since = t_s
         segment_driving, before_s = driving, 0.0

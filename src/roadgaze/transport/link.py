@@ -343,7 +343,9 @@ class ZenohLink:
         )
 
     def publish_final_state(self) -> None:
-        """Put the current state on the state key (for subscribers; queries get it anyway)."""
+        """Put the current state on the state key (for subscribers; queries get it anyway). It is
+        the service's last word, put just before the session closes: like an alert it goes out
+        at once (express, REAL_TIME), not in a batch behind the frames' data."""
         declared = self._declared
         if self.state_reply is None or declared is None:
             return
@@ -355,6 +357,8 @@ class ZenohLink:
                 self.state_reply(),
                 encoding=zenoh.Encoding.APPLICATION_JSON,
                 congestion_control=zenoh.CongestionControl.BLOCK,
+                priority=zenoh.Priority.REAL_TIME,
+                express=True,
             )
         except Exception as exc:
             log.warning("final state not published: %s", exc)

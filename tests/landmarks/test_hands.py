@@ -85,6 +85,23 @@ def test_a_corrupt_model_is_one_line_naming_it(tmp_path: Path) -> None:
     assert "\n" not in str(caught.value)
 
 
+def test_a_cache_that_cannot_take_the_models_is_one_line_before_any_download(
+    tmp_path: Path,
+) -> None:
+    """A model cache that cannot be written (here: under a file; in the container image: the
+    read-only model folder) is refused before anything is downloaded, so the demo run there
+    does not fetch 35 MB to throw away."""
+    from roadgaze.config.settings import ModelConfig
+    from roadgaze.landmarks.hands.models import fetch_hand_models
+
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    config = ModelConfig(cache_dir=blocker / "cache", download_timeout_s=0.001)
+    with pytest.raises(ModelError, match=r"the model cache .*cache cannot be made") as caught:
+        fetch_hand_models(config)
+    assert "\n" not in str(caught.value)
+
+
 # --- MediaPipe 0.10.14 on real drivers ---------------------------------------------------------
 
 

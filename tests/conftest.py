@@ -37,20 +37,6 @@ def scope_of(nodeid: str) -> str:
     return next((folder for folder in ONE_WORKER_FOLDERS if path.startswith(folder)), path)
 
 
-WAITING_SHARE = 0.25
-"""About this share of a worker's time is spent waiting (on child processes, Zenoh, sockets and
-timeouts): the parallel run kept 1.5 of 2 cores busy with one worker per core."""
-
-
-@pytest.hookimpl(optionalhook=True)
-def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: one worker per core and, for the share of time workers wait, one more per three
-    cores (at least one): 3 workers on 2 cores."""
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    cores = cores or 1
-    return cores + max(1, round(cores * WAITING_SHARE / (1 - WAITING_SHARE)))
-
-
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
     """`--dist loadfile` (pyproject.toml), by `scope_of`: a file runs on one worker (its module

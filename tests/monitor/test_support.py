@@ -153,6 +153,33 @@ def test_every_non_road_zone_raises_support_at_the_first_sample(
     assert first(seen, "normal", 3.0) == pytest.approx(6.0)
 
 
+@pytest.mark.parametrize(("yaw_deg", "pitch_deg"), [(22.0, 0.0), (-24.0, 0.0), (0.0, -12.0)])
+def test_a_head_past_the_road_entry_bound_raises_support_while_the_zone_stays_the_road(
+    yaw_deg: float, pitch_deg: float
+) -> None:
+    # a 30 deg mirror look whose head reads 22-24 deg: past the road's entry bound (20 deg),
+    # inside its exit bound (25 deg), so the zone is still the road and nothing warns
+    look = Pose(yaw_deg=yaw_deg, pitch_deg=pitch_deg, eyes=eyes_of())
+    seen, alerts = drive(glance(3.0, 7.0, look), 10.0)
+    assert first(seen, "heightened", 2.5) == pytest.approx(3.0)
+    raised = at(seen, 3.0)
+    assert (raised.rule, raised.reason) == (
+        "euroncap.support.forward",
+        "head past the road's edge",
+    )
+    assert first(seen, "normal", 3.0) == pytest.approx(9.0)  # back at 7.0 + support_clear_s
+    assert alerts == []  # on the road by hysteresis: no distraction
+    off = CONFIG.model_copy(update={"support_road_edge": False})
+    seen, _ = drive(glance(3.0, 7.0, look), 10.0, off)
+    assert all(forward.value == "normal" for t, forward, _ in seen if t >= 2.0 - 1e-9)
+
+
+def test_a_head_within_the_road_entry_bound_keeps_support_normal() -> None:
+    look = Pose(yaw_deg=19.0, pitch_deg=-9.0, eyes=eyes_of())
+    seen, _ = drive(glance(3.0, 7.0, look), 10.0)
+    assert all(forward.value == "normal" for t, forward, _ in seen if t >= 2.0 - 1e-9)
+
+
 def test_support_raise_s_delays_the_raise_and_a_shorter_glance_raises_nothing() -> None:
     config = CONFIG.model_copy(update={"support_raise_s": 0.4})
     look = Pose(yaw_deg=0.0, pitch_deg=-30.0, eyes=eyes_of())

@@ -22,6 +22,12 @@ class SupportSettings(Section):
     support_clear_s: float = Field(default=2.0, ge=0)
     """Support returns to normal once the driver has watched the road, with everything known,
     this long."""
+    support_road_edge: bool = True
+    """A head past the road's entry bound (`road_half_width_deg - hysteresis_deg`, 20 deg of yaw;
+    the road's pitch band) counts as not watching the road, though the zone stays the road until
+    its exit bound (25 deg): the hysteresis keeps the warnings from flapping, support is raised at
+    the entry bound. A 30 deg mirror look whose head reads 21-25 deg raises support (false support
+    costs an earlier FCW; a missed one, a later one). False: support at the zone's edge only."""
     support_hold_impaired: bool = True
     """An impairment alert (drowsy, microsleep, sleep: a rule marked `impairment`) holds support
     heightened to the end of the trip."""

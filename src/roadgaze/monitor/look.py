@@ -69,6 +69,10 @@ class Look:
     """The yaw of the last sample with a usable yaw."""
     place: HeadPlace = field(default_factory=HeadPlace)
     """The head's place (body lean) and its learned driving place (roadgaze.monitor.lean)."""
+    past_road_edge: bool = False
+    """On the road by hysteresis only: the head is past the road's entry bound (its rectangle:
+    `road_half_width_deg - hysteresis_deg` of yaw, `road_pitch_deg`), not yet past its exit
+    bound. Forward and lane support count it as not watching the road (`support_road_edge`)."""
 
     @property
     def on_road(self) -> bool:
@@ -120,7 +124,10 @@ def classify(
     place = step_place(config, mounting, previous.place, sample, turn, zone == ROAD)
     if leaning(config, place.lean_m) and (zone == ROAD or zones.is_driving_related(zone)):
         gaze, zone, face_zone, by_eyes = Gaze.OFF_ROAD, LEAN_ZONE, LEAN_ZONE, False
-    return Look(gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes, last_yaw, place)
+    past_edge = zone == ROAD and yaw is not None and not zones.zones[0].contains(*turn)
+    return Look(
+        gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes, last_yaw, place, past_edge
+    )
 
 
 def _judge(

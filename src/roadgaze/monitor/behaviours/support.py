@@ -3,8 +3,9 @@
 One behaviour per channel (`support_forward`, `support_lane`), published at every sample with
 its rule, reason and since when (`Publish`). Heightened once the driver has not been watching
 the road for `support_raise_s` (0: at the first such sample): any zone but the road, driving-task
-glances (mirrors, cluster) included, the eyes closed, or a phone in use (the `phone_use` alert in
-force); and, fail-safe, whenever the service
+glances (mirrors, cluster) included, the head past the road's entry bound while the zone is still
+the road by hysteresis (`support_road_edge`), the eyes closed, or a phone in use (the `phone_use`
+alert in force); and, fail-safe, whenever the service
 cannot tell (no face, two faces, the eyes unavailable, no speed, a bad frame). Normal again once
 the driver has watched the road, everything known, for `support_clear_s`. An alert whose rule is
 an impairment (`Rule.impairment`: drowsy, microsleep, sleep) holds it heightened to the end of
@@ -67,7 +68,7 @@ class Support:
     def step(self, context: Context, state: SupportState) -> tuple[SupportState, tuple[Event, ...]]:
         config, t_s = context.config, context.t_s
         impaired = state.impaired or (_impairment(context) if config.support_hold_impaired else "")
-        away = ("" if context.looking else _away(context)) or _phone(context)
+        away = ("" if context.looking else _away(context)) or _past_edge(context) or _phone(context)
         unknown = _unknown(context) if context.looking or not away else ""
         watching = not (away or unknown)
         watching_since = run_since(watching, state.watching_since_s, t_s)
@@ -140,4 +141,12 @@ def _away(context: Context) -> str:
         return where if context.sample.face else f"face out of view, last seen in {look.zone}"
     if look.gaze is Gaze.ON_ROAD and context.eyes.status is EyeStatus.CLOSED:
         return "eyes closed"
+    return ""
+
+
+def _past_edge(context: Context) -> str:
+    """The head past the road's entry bound, the zone still the road by hysteresis ('' when
+    not, or `support_road_edge` is off)."""
+    if context.config.support_road_edge and context.look.past_road_edge:
+        return "head past the road's edge"
     return ""

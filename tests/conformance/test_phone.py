@@ -70,5 +70,16 @@ def test_a_phone_held_up_at_the_wheel_or_the_cluster_warns(place: str, tmp_path:
     # The hand is found at the stage's first run after the phone comes up (0.33 s: every
     # 0.3 s at 15 fps), then the rule's 3 s; put down, the warning clears.
     assert 3.0 <= outcomes[f"{name}.warns"]["measured_s"] <= 3.7
-    alerts = outcomes[f"{name}.warns"]["alerts"]
-    assert [a.split("@")[0] for a in alerts] == ["phone_use:warning", "cleared:info"]
+    alerts = [a.split("@")[0] for a in outcomes[f"{name}.warns"]["alerts"]]
+    if place == "wheel":
+        # The eyes on the phone at the wheel (15 deg outboard, 20 down: 2.5 thresholds) count in
+        # full and take the gaze off the road into the cluster's zone: a long distraction warns
+        # 0.2 s before the phone (docs/eyes.md, "Eye movements through lenses, makeup and a brim").
+        assert alerts == [
+            "long_distraction:warning",
+            "phone_use:warning",
+            "cleared:info",
+            "cleared:info",
+        ]
+    else:
+        assert alerts == ["phone_use:warning", "cleared:info"]

@@ -3,6 +3,7 @@ PERCLOS against closed forms, gaze with its deadband, unavailable eyes and degra
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -10,7 +11,7 @@ import pytest
 
 from fakes import eyes_of
 from roadgaze.config import MonitorConfig
-from roadgaze.monitor.eye_rules import classify_eyes, gaze_deg, soft_threshold
+from roadgaze.monitor.eye_rules import classify_eyes, firm_threshold, gaze_deg, soft_threshold
 from roadgaze.monitor.eyes import EyesAlone, clearable_eye_kinds, step_eyes
 from roadgaze.types import (
     AlertKind,
@@ -146,6 +147,24 @@ def test_soft_threshold_and_gaze() -> None:
     assert gaze_deg(0.0, 0.0, eyes_of(eye_yaw=-30.0), 10.0, (-25.0, 0.0))[0] == 0.0
 
 
+@pytest.mark.parametrize(
+    ("value", "full_factor", "expected"),
+    [
+        (8.0, 2.0, 0.0),  # within the deadband: nothing
+        (10.0, 2.0, 0.0),  # continuous at the deadband
+        (15.0, 2.0, 10.0),  # the ramp: 20 (15 - 10) / 10
+        (-18.0, 2.0, -16.0),
+        (20.0, 2.0, 20.0),  # continuous at twice the deadband
+        (-25.8, 2.0, -25.8),  # beyond: all of it (soft: -15.8)
+        (15.0, 3.0, 7.5),  # a longer ramp: 30 (15 - 10) / 20
+        (10.5, 1.0, 10.5),  # 1: a hard threshold
+        (-25.8, math.inf, -15.8),  # infinite: the soft threshold
+    ],
+)
+def test_firm_threshold_closed_forms(value: float, full_factor: float, expected: float) -> None:
+    assert firm_threshold(value, 10.0, full_factor) == pytest.approx(expected)
+
+
 def test_open_eyes_raise_nothing_and_blinks_are_counted() -> None:
     blinks = [(1.8, {}), (0.2, {"openness": 0.08})] * 10
     events, states = drive([(2.0, {}), *blinks, (2.0, {})])
@@ -245,7 +264,7 @@ def test_the_eye_neutral_is_learned_on_the_road_and_gaze_uses_it() -> None:
     neutral = states[-1].eyes.eye_neutral_deg
     assert neutral == pytest.approx((-6.0, 3.0), abs=0.1)
     _, states = drive([(30.0, {"eye_yaw": -6.0}), (1.0, {"eye_yaw": -36.0})])
-    assert states[-1].verdict.gaze_yaw_deg == pytest.approx(-20.0, abs=0.5)
+    assert states[-1].verdict.gaze_yaw_deg == pytest.approx(-30.0, abs=0.5)  # 3 thresholds: all
     assert states[-1].verdict.gaze_source == "eyes"
     _, states = drive([(2.0, {}), (1.0, {"openness": 0.05})])
     assert states[-1].verdict.gaze_source == "head"  # closed eyes give no direction

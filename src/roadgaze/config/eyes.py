@@ -69,8 +69,9 @@ class EyeMonitorSettings(Section):
     """Eye-in-head deviations from the driver's resting eye direction below this count as none."""
     eyes_road_margin_deg: float = Field(default=5.0, ge=0)
     """With the eyes measured, the road zone is narrower by this in yaw (both sides) and at its
-    lower edge, so an eyes-only glance beyond 30 deg sideways or 20 deg down leaves it despite
-    the deadband (with the default road)."""
+    lower edge, so an eyes-only glance beyond 20 deg sideways or 15 deg down leaves it (with the
+    default road and deadband), although MediaPipe reads a glance through tinted lenses or under
+    heavy lashes about a fifth short (docs/eyes.md)."""
     eye_neutral_limit_deg: float = Field(default=15.0, ge=0)
     """The learned resting eye yaw is used within +-this (Pointing'04: per-subject resting yaw
     -8..+17 deg, docs/eyes.md)."""
@@ -83,6 +84,11 @@ class EyeMonitorSettings(Section):
     eye_noise_sigmas: float = Field(default=3.0, gt=0)
     """The eyes move the gaze only beyond this many of the driver's measured standard deviations
     of each axis (and never within `gaze_deadband_deg`)."""
+    eye_full_shift_factor: float = Field(default=2.0, ge=1)
+    """An eye movement beyond this many of its thresholds moves the gaze by all of it; between one
+    and this many, by a ramp from 0 (firm shrinkage; infinite: the soft threshold, where every
+    glance is shortened by the threshold). roadgaze's choice: twice the 10 deg deadband is 5.7
+    standard deviations of the noisiest real clip's eye pitch, 3.5 deg (docs/eyes.md)."""
     microsleep_s: float = Field(default=1.0, gt=0)
     sleep_s: float = Field(default=3.0, gt=0)
     unresponsive_closed_s: float = Field(default=6.0, gt=0)

@@ -14,8 +14,10 @@ gaze built on uncalibrated eyes puts a driver who looks ahead into the lap. So:
   noise still learning from on-road samples would grow with every small glance the threshold lets
   through) and the resting direction follows the driver slowly (first-order lag, 60 s).
 - **Thresholds.** Per axis, max(`gaze_deadband_deg`, `eye_noise_sigmas` x the driver's measured
-  standard deviation on that axis): only an eye movement beyond the measured noise moves the gaze,
-  by the part beyond the threshold (soft threshold).
+  standard deviation on that axis): only an eye movement beyond the measured noise (its size in
+  thresholds over 1) moves the gaze, by a ramp up to all of it at `eye_full_shift_factor`
+  thresholds (firm threshold), never nearer the road ahead than each axis's part beyond its
+  threshold (soft threshold) would (`eye_shift_deg`).
 - **Limits.** The resting direction used is clamped to +-`eye_neutral_limit_deg` (yaw) and
   +-`eye_neutral_pitch_limit_deg` (pitch).
 
@@ -28,10 +30,16 @@ import math
 from dataclasses import dataclass
 
 from roadgaze.config import MonitorConfig
-from roadgaze.monitor.eye_rules import soft_threshold
+from roadgaze.monitor.eye_rules import firm_threshold, soft_threshold
 from roadgaze.types import EyeCalibrationStatus
 
-__all__ = ["EyeCalibration", "eye_shift_deg", "learn_calibration", "thresholds_deg"]
+__all__ = [
+    "EyeCalibration",
+    "eye_shift_deg",
+    "fail_safe_shift",
+    "learn_calibration",
+    "thresholds_deg",
+]
 
 _MAX_STEP_S = 1.0
 """A longer gap between samples teaches no more than one second would."""
@@ -133,17 +141,39 @@ def eye_shift_deg(
     calibration: EyeCalibration,
     eye_yaw_deg: float | None,
     eye_pitch_deg: float | None,
+    head_turn_deg: tuple[float, float] = (0.0, 0.0),
 ) -> tuple[float, float] | None:
-    """How far the eyes move the gaze (yaw, pitch degrees): each axis's deviation from the resting
-    direction, soft-thresholded by `thresholds_deg`. None until calibrated or without a direction
-    (the gaze is then the head pose)."""
+    """How far the eyes move the gaze (yaw, pitch degrees). The deviation from the resting
+    direction is one eye movement: its size in units of each axis's `thresholds_deg` (an ellipse)
+    decides whether it is beyond the noise, and it is shrunk along its own direction, so an
+    oblique glance is not cut to its larger component. Each axis then takes `fail_safe_shift`'s
+    choice between that and the axis's own soft threshold. `head_turn_deg`: the head's yaw and
+    pitch from the road ahead. None until calibrated or without a direction (the gaze is then
+    the head pose)."""
     if not calibration.calibrated or eye_yaw_deg is None or eye_pitch_deg is None:
         return None
     if not (math.isfinite(eye_yaw_deg) and math.isfinite(eye_pitch_deg)):
         return None
     rest_yaw, rest_pitch = calibration.resting_deg(config)
     yaw_threshold, pitch_threshold = thresholds_deg(config, calibration)
+    d_yaw, d_pitch = eye_yaw_deg - rest_yaw, eye_pitch_deg - rest_pitch
+    size = math.hypot(d_yaw / max(yaw_threshold, 1e-9), d_pitch / max(pitch_threshold, 1e-9))
+    if size <= 1.0:
+        return 0.0, 0.0
+    firm = firm_threshold(size, 1.0, config.eye_full_shift_factor) / size
     return (
-        soft_threshold(eye_yaw_deg - rest_yaw, yaw_threshold),
-        soft_threshold(eye_pitch_deg - rest_pitch, pitch_threshold),
+        fail_safe_shift(d_yaw * firm, soft_threshold(d_yaw, yaw_threshold), head_turn_deg[0]),
+        fail_safe_shift(d_pitch * firm, soft_threshold(d_pitch, pitch_threshold), head_turn_deg[1]),
     )
+
+
+def fail_safe_shift(firm_deg: float, soft_deg: float, head_turn_deg: float) -> float:
+    """One axis's eye shift: the firm threshold's (a large movement counts in full), unless that
+    brings the gaze nearer the road ahead than the axis's soft threshold (every deviation
+    shortened by the threshold: the rule before the firm one) does; then the soft one. With the
+    head turned, MediaPipe reads still eyes as turned back toward the camera by up to 15-20 deg
+    (docs/eyes.md): counted in full, that would pull the gaze of a head turned off the road back
+    onto it."""
+    if abs(head_turn_deg + firm_deg) >= abs(head_turn_deg + soft_deg):
+        return firm_deg
+    return soft_deg

@@ -17,6 +17,7 @@ __all__ = [
     "POPULATION_OPEN",
     "classify_eyes",
     "eye_zone_map",
+    "firm_threshold",
     "gaze_deg",
     "hidden_reason",
     "soft_threshold",
@@ -29,6 +30,22 @@ POPULATION_OPEN = 0.30
 def soft_threshold(value_deg: float, deadband_deg: float) -> float:
     """sign(v) max(0, |v| - deadband): deviations inside the deadband count as none."""
     return math.copysign(max(0.0, abs(value_deg) - deadband_deg), value_deg)
+
+
+def firm_threshold(value_deg: float, deadband_deg: float, full_factor: float) -> float:
+    """Zero within the deadband T, all of the value beyond `full_factor` x T, and a straight ramp
+    between them (Gao and Bruce's firm shrinkage): continuous like `soft_threshold`, but a large
+    deviation is not shortened by T. `full_factor` must be >= 1 (1: a hard threshold; infinite:
+    `soft_threshold`)."""
+    size = abs(value_deg)
+    if size <= deadband_deg:
+        return 0.0
+    full_deg = full_factor * deadband_deg
+    if size >= full_deg:
+        return value_deg
+    if math.isinf(full_factor):
+        return soft_threshold(value_deg, deadband_deg)
+    return math.copysign(full_deg * (size - deadband_deg) / (full_deg - deadband_deg), value_deg)
 
 
 def gaze_deg(

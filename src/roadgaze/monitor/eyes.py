@@ -19,7 +19,7 @@ Definitions (thresholds in `MonitorConfig`; defaults and sources in docs/monitor
 - **PERCLOS**: the closed share of the judged time in the last `perclos_window_s`, kept in 1 s
   bins (memory bounded whatever the frame rate), reported once `perclos_min_judged_s` is judged.
 - **Gaze** = head pose + the eye direction's deviation from the driver's resting eye direction,
-  soft-thresholded per axis beyond the driver's measured noise (`roadgaze.monitor.eye_calibration`);
+  thresholded beyond the driver's measured noise (`roadgaze.monitor.eye_calibration`);
   the head pose alone until the eyes are calibrated, or when they give no direction or are closed.
   The calibration, the road pitch and the open-eye baseline learn from open-eyed samples on the
   road with a steady head (|yaw rate| <= `neutral_max_rate_dps`).
@@ -149,12 +149,14 @@ def measure_eyes(
     on_road: bool,
     head_yaw_deg: float | None,
     head_pitch_deg: float | None,
+    neutral_deg: tuple[float, float] = (0.0, 0.0),
 ) -> EyeMonitorState:
     """Measure the eyes at one more sample; returns the new state.
 
     `on_road`: the monitor's road decision at the previous sample (the neutral values learn only
     on road). `head_yaw_deg`, `head_pitch_deg`: the head pose the gaze is built on (None without
-    one). A sample not after the previous one is ignored.
+    one); `neutral_deg`: the monitor's road-ahead yaw and pitch, which the eye shift measures the
+    head's turn from (`eye_shift_deg`). A sample not after the previous one is ignored.
     """
     t = sample.t_s
     if not math.isfinite(t) or (state.t_s is not None and t <= state.t_s):
@@ -192,7 +194,7 @@ def measure_eyes(
         unavailable_since_s=unavailable_since,
         degraded=degraded,
     )
-    verdict = _verdict(config, measured, eyes, head_yaw_deg, head_pitch_deg)
+    verdict = _verdict(config, measured, eyes, head_yaw_deg, head_pitch_deg, neutral_deg)
     return replace(measured, verdict=verdict)
 
 
@@ -309,6 +311,7 @@ def _verdict(
     eyes: EyesFeatures | None,
     head_yaw_deg: float | None,
     head_pitch_deg: float | None,
+    neutral_deg: tuple[float, float],
 ) -> EyesVerdict:
     """The eyes' part of the frame's verdict. Gaze: the calibrated eyes when open and giving a
     direction, else the head pose."""
@@ -319,7 +322,13 @@ def _verdict(
         gaze_yaw, gaze_pitch = head_yaw_deg, head_pitch_deg if head_pitch_deg is not None else 0.0
         source = "head"
         shift = (
-            eye_shift_deg(config, calibration, eyes.yaw_deg, eyes.pitch_deg)
+            eye_shift_deg(
+                config,
+                calibration,
+                eyes.yaw_deg,
+                eyes.pitch_deg,
+                (gaze_yaw - neutral_deg[0], gaze_pitch - neutral_deg[1]),
+            )
             if status is EyeStatus.OPEN and eyes is not None
             else None
         )

@@ -48,6 +48,7 @@ def observe(
         state.on_road,
         head_yaw,
         state.neutral.pitch_deg if head_pitch is None else head_pitch,
+        (state.neutral.yaw_deg, state.neutral.pitch_deg),
     )
     look = classify(config, zones, state.look, state.neutral, sample, eyes.verdict, mounting)
     issue = frame_issue(config, sample.frame_check)

@@ -80,3 +80,21 @@ def test_eval_task_phone_bad_dataset_is_one_line(tmp_path: Path) -> None:
     done = _roadgaze("eval", str(tmp_path), "--task", "phone")
     assert done.returncode == 2
     assert done.stderr.strip().count("\n") == 0 and "file,phone_use" in done.stderr
+
+
+@pytest.mark.parametrize(
+    ("conditions", "message"),
+    [
+        (["ir_grey", "dark"], "--task phone takes one --condition, found ir_grey, dark"),
+        (["all"], "--task phone takes one --condition, found all"),
+        (["infrared"], "unknown condition 'infrared'"),
+    ],
+)
+def test_eval_task_phone_takes_one_known_condition(
+    tmp_path: Path, conditions: list[str], message: str
+) -> None:
+    (tmp_path / "ground_truth.csv").write_text("file,phone_use\na.jpg,1\n", encoding="utf-8")
+    flags = [part for name in conditions for part in ("--condition", name)]
+    done = _roadgaze("eval", str(tmp_path), "--task", "phone", *flags)
+    assert done.returncode == 2
+    assert done.stderr.strip().count("\n") == 0 and message in done.stderr

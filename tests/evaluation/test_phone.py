@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from repo_paths import STATEFARM
@@ -79,3 +80,20 @@ def test_the_shipped_classifier_on_its_own_training_drivers(dev_features) -> Non
     scores = np.array([model.score(row) for row in dev_features.x])
     report = score_report(dev_features, scores, model.threshold)
     assert report.recall > 0.8 and report.fpr < 0.1  # seen drivers: a floor, not a claim
+
+
+def test_the_images_are_put_under_the_condition_before_the_hand_stage() -> None:
+    """Four phone-at-the-ear images: under `ir_grey` the hands and the body read differently,
+    and again the same on a second run (the noise is seeded by the file name)."""
+    if not (STATEFARM / "ground_truth.csv").is_file():
+        pytest.skip(f"no State Farm development images at {STATEFARM}")
+    config = load_config(environ={})
+    truths = [t for t in load_phone_truth(STATEFARM) if t.label == "c2"][:4]
+    try:
+        clean = image_features(STATEFARM, truths, config)
+    except ModelError as exc:
+        pytest.skip(f"hand models unavailable: {exc}")
+    grey = image_features(STATEFARM, truths, config, condition="ir_grey")
+    again = image_features(STATEFARM, truths, config, condition="ir_grey")
+    assert not np.array_equal(clean.x, grey.x, equal_nan=True)
+    np.testing.assert_array_equal(grey.x, again.x)

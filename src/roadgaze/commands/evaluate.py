@@ -80,7 +80,8 @@ def register(subparsers: Any) -> None:
         help="run the condition suite instead: the images with |yaw| <= 60, clean and under "
         "this cabin condition (repeatable, or `all`: ir_grey, dark, glare, motion_blur, jpeg, "
         "low_res, sunglasses, mask; docs/conditions.md), one table row each; NAME:KEY=VALUE,... "
-        "sets a condition's parameters, e.g. ir_grey:noise_std=9",
+        "sets a condition's parameters, e.g. ir_grey:noise_std=9; with --task phone: the one "
+        "condition every image is put under",
     )
     parser.set_defaults(handler=run)
 

@@ -8,6 +8,8 @@ import json
 import numpy as np
 
 from roadgaze.config import Config
+from roadgaze.errors import ConfigError
+from roadgaze.evaluation.conditions import CLEAN, parse_condition
 from roadgaze.logs import log_written
 
 
@@ -32,20 +34,25 @@ def run_phone(args: argparse.Namespace, config: Config) -> int:
         {"--report": args.report},
         {},
     )
+    condition = _phone_condition(args.condition)
     truths = load_phone_truth(args.dataset)
     model = load_model()
     threshold = (
         model.threshold if config.hands.phone_threshold is None else (config.hands.phone_threshold)
     )
-    features = image_features(args.dataset, truths, config, progress=not args.no_progress)
+    features = image_features(
+        args.dataset, truths, config, progress=not args.no_progress, condition=condition
+    )
     scores = np.array([np.nan if np.isnan(row).any() else model.score(row) for row in features.x])
     shipped = score_report(features, scores, threshold)
     document: dict[str, object] = {
         "dataset": str(args.dataset),
+        "condition": condition,
         "model": {"version": model.version, "training": model.training},
         "shipped": report_json(shipped),
     }
-    print(format_report(f"Phone use on {args.dataset}, shipped classifier", shipped))
+    under = "" if condition == CLEAN else f" under {condition}"
+    print(format_report(f"Phone use on {args.dataset}{under}, shipped classifier", shipped))
     if len(set(features.groups) - {""}) >= 2:
         settings = BoostSettings(**model.training.get("settings", {}))
         held = out_of_fold_scores(features, settings)
@@ -58,3 +65,21 @@ def run_phone(args: argparse.Namespace, config: Config) -> int:
         args.report.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
         log_written(args.report)
     return 0
+
+
+def _phone_condition(requested: list[str] | None) -> str:
+    """The one condition the images are put under (`clean` without `--condition`); ConfigError
+    for more than one, `all`, or an unknown condition or parameter."""
+    if not requested:
+        return CLEAN
+    if len(requested) > 1 or requested[0] == "all":
+        raise ConfigError(
+            f"--task phone takes one --condition, found {', '.join(requested)}; "
+            "run once per condition"
+        )
+    if requested[0] != CLEAN:
+        try:
+            parse_condition(requested[0])
+        except ValueError as exc:
+            raise ConfigError(f"--condition: {exc}") from None
+    return requested[0]

@@ -43,6 +43,11 @@ class HandsConfig(Section):
     """The body at most this often (0: with every run of the hands); runs of the hands in
     between carry the last body. An arm holding a phone moves slowly; the body costs about three
     times the hands (docs/phone.md, Cost)."""
+    enhance: Literal["auto", "off", "always"] = "auto"
+    """The hand stage's front end (roadgaze.landmarks.hands.front_end): `auto` lifts a flat
+    frame (as the face's front end judges it) for the hand and body models, smoothing its noise
+    first; `off` passes frames as they come; `always` lifts every frame (docs/phone.md, "At
+    night")."""
     phone_threshold: float | None = Field(default=None, ge=0, le=1)
     """The phone score from which a frame is judged phone use; None: the shipped classifier's
     own operating point (chosen leaving drivers out, docs/phone.md)."""

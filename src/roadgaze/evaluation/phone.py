@@ -112,11 +112,18 @@ class Features:
 
 
 def image_features(
-    dataset: Path, truths: Sequence[PhoneTruth], config: Any, progress: bool = False
+    dataset: Path,
+    truths: Sequence[PhoneTruth],
+    config: Any,
+    progress: bool = False,
+    condition: str = "clean",
 ) -> Features:
-    """Every image's feature vector (hands and face as stills); DatasetError without the hand
-    models or when no image can be read."""
+    """Every image's feature vector (hands and face as stills), each image first put under
+    `condition` (`roadgaze.evaluation.conditions.apply_condition`: seeded by its file name; one
+    that draws on the face gets the fixed face box); DatasetError without the hand models or
+    when no image can be read."""
     from roadgaze.errors import ModelError
+    from roadgaze.evaluation.conditions import apply_condition
     from roadgaze.evaluation.images import read_image
     from roadgaze.landmarks.hands.stage import HandStage
     from roadgaze.landmarks.landmarker import Landmarker
@@ -136,6 +143,7 @@ def image_features(
                 image = read_image(dataset / truth.file)
             except (OSError, ValueError, SourceError):
                 continue
+            image = apply_condition(condition, image, None, truth.file)
             hands = stage.run(image, None)
             face = faces.detect(image).driver
             box = face_box(face)

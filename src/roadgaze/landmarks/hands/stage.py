@@ -3,10 +3,11 @@
 `HandStage.from_config` loads the verified models named by `[hands] models` from the model cache;
 when they are missing or damaged it logs one line naming the file and the fix and returns None:
 the service then runs without hands, and phone detection is off (the record's hand fields are
-null). `run(image, t_s)` gives the hands of a BGR frame; in a stream it runs the models at most
-every `interval_s` and returns the last hands in between (`fresh` says which). With `[hands]
-body` (the default) the driver's upper body is found at the same pace (MediaPipe's pose models,
-provisioned with the hand models).
+null). `run(image, t_s)` gives the hands of a BGR frame (a flat one lifted first by the stage's
+front end, `[hands] enhance`: roadgaze.landmarks.hands.front_end); in a stream it runs the
+models at most every `interval_s` and returns the last hands in between (`fresh` says which).
+With `[hands] body` (the default) the driver's upper body is found at the same pace
+(MediaPipe's pose models, provisioned with the hand models).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import numpy.typing as npt
 from roadgaze.config import Config, HandsConfig
 from roadgaze.errors import ModelError
 from roadgaze.landmarks.hands.engine import HandArrays, HandLandmarker, HandSettings
+from roadgaze.landmarks.hands.front_end import for_hands
 from roadgaze.landmarks.hands.models import model_names, resolve_hand_models
 from roadgaze.landmarks.pose.engine import PoseArrays, PoseLandmarker, PoseSettings
 from roadgaze.landmarks.pose.models import DETECTOR_NAME, LANDMARKS_NAME
@@ -83,6 +85,7 @@ class HandStage:
         self._last_body_t_s: float | None = None
         self.body_runs = 0
         self._interval_s = config.interval_s
+        self._enhance = config.enhance
         self._last_t_s: float | None = None
         self._last: tuple[Hand, ...] = ()
         self.runs = 0
@@ -140,7 +143,7 @@ class HandStage:
         last = self._last_t_s
         if t_s is not None and last is not None and last <= t_s < last + self._interval_s:
             return HandsOfFrame(self._last, False, size, self._last_body)
-        rgb = to_rgb(image)
+        rgb = to_rgb(for_hands(image, self._enhance))
         timestamp_ms = None if t_s is None else round(t_s * 1000)
         found = self._landmarker.run(rgb, timestamp_ms)
         self._last = tuple(to_hand(hand, size) for hand in found)

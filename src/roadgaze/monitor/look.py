@@ -13,7 +13,7 @@ from roadgaze.monitor.lean import LEAN_ZONE, HeadPlace, leaning, step_place
 from roadgaze.monitor.neutral import NeutralPose
 from roadgaze.monitor.zones import AWAY, ROAD, ZoneMap
 from roadgaze.mounting import CameraMounting, gaze_to_driver
-from roadgaze.types import EyesVerdict, Gaze, PoseSample
+from roadgaze.types import EyeStatus, EyesVerdict, Gaze, PoseSample
 
 __all__ = ["Look", "classify", "finite", "to_driver_frame"]
 
@@ -101,6 +101,18 @@ def _eyes_moved(eyes: EyesVerdict, head_yaw_deg: float, head_pitch_deg: float) -
     )
 
 
+def _closed_after_eye_glance(previous: Look, eyes: EyesVerdict, head_zone: str) -> bool:
+    """The eyes read closed, the head on the road, and the previous sample was an eyes-only
+    glance off the road: the glance holds its zone while the lids read closed."""
+    return (
+        eyes.status is EyeStatus.CLOSED
+        and head_zone == ROAD
+        and previous.by_eyes
+        and previous.gaze is Gaze.OFF_ROAD
+        and previous.zone is not None
+    )
+
+
 def classify(
     config: MonitorConfig,
     zones: ZoneMap,
@@ -168,6 +180,20 @@ def _judge(
                 ):
                     gaze = Gaze.ON_ROAD if gaze_zone == ROAD else Gaze.OFF_ROAD
                     return gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, True
+            elif _closed_after_eye_glance(previous, eyes, zone):
+                # Lids that close during an eyes-only glance off the road keep its place: the
+                # lid follows a look down and may read closed (docs/eyes.md); the closure rules
+                # run as well, so nothing is hidden, and the distraction is not cut short.
+                return (
+                    Gaze.OFF_ROAD,
+                    previous.zone,
+                    previous.face_zone,
+                    yaw,
+                    pitch,
+                    None,
+                    False,
+                    True,
+                )
         gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
         return gaze, zone, zone, yaw, pitch, None, False, False
     if previous.lost_since_s is not None:

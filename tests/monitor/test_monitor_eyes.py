@@ -174,7 +174,7 @@ def test_lids_that_read_closed_during_an_eyes_only_glance_keep_its_place_and_its
             return 0.0, lid_down
         return 0.0, eyes_of()
 
-    monitor, alerts = run(script, 8.0)
+    _, alerts = run(script, 8.0)
     labels = kinds(alerts)
     # the closure rules run as well: nothing is hidden
     assert labels[:2] == ["microsleep:warning", "long_distraction:warning"]

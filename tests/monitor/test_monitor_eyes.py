@@ -192,6 +192,18 @@ def test_lids_that_read_closed_during_an_eyes_only_glance_keep_its_place_and_its
     _, closed = run(between(2.0, 6.0, lid_down), 8.0)
     assert "long_distraction:warning" not in kinds(closed)
 
+    # a closing lid pulls the eye reading down for a frame: shorter than a fixation
+    # (closed_glance_min_s, 0.1 s), so the closure is judged as one, with no distraction
+    def closing(t_s: float) -> tuple[float, EyesFeatures | None]:
+        if 2.0 <= t_s + 1e-9 < 2.0 + 1 / FPS:
+            return 0.0, down
+        if 2.0 + 1 / FPS <= t_s + 1e-9 < 6.0:
+            return 0.0, lid_down
+        return 0.0, eyes_of()
+
+    _, sleep = run(closing, 8.0)
+    assert kinds(sleep) == ["microsleep:warning", "sleep:critical", "cleared:info"]
+
 
 def test_unresponsive_when_not_back_three_seconds_after_a_vats_warning() -> None:
     # Mirror glances (driving-related: VATS counts them, long_distraction does not) add up to

@@ -162,49 +162,6 @@ def test_closed_eyes_are_not_eyes_on_the_road_and_keep_their_alerts() -> None:
     assert kinds(alerts) == ["microsleep:warning"]
 
 
-def test_lids_that_read_closed_during_an_eyes_only_glance_keep_its_place_and_its_closure() -> None:
-    # An eyes-only look down into the lap: open for half a second, then the lid, following the
-    # eye down, reads closed (openness 0.05) with the head still on the road.
-    down, lid_down = eyes_of(eye_pitch=-32.0), eyes_of(openness=0.05, eye_pitch=-32.0)
-
-    def script(t_s: float) -> tuple[float, EyesFeatures | None]:
-        if 2.0 <= t_s + 1e-9 < 2.5:
-            return 0.0, down
-        if 2.5 <= t_s + 1e-9 < 6.0:
-            return 0.0, lid_down
-        return 0.0, eyes_of()
-
-    _, alerts = run(script, 8.0)
-    labels = kinds(alerts)
-    # the closure rules run as well: nothing is hidden
-    assert labels[:2] == ["microsleep:warning", "long_distraction:warning"]
-    assert near(alerts[0].t_s, 3.5)  # 1 s of closure from 2.5
-    assert near(alerts[1].t_s, 5.0) and alerts[1].reason == "eyes in lap"  # 3 s of the glance
-    assert labels[2:] == ["sleep:critical", "cleared:info"]  # a closure of 3.5 s, then back
-    probe = Monitor(FIXED)
-    for frame in range(round(4.0 * FPS)):
-        t_s = frame / FPS
-        probe.update(_sample(t_s, script(t_s)[1]), None)
-    verdict = probe.verdict
-    assert verdict.eyes.status is EyeStatus.CLOSED
-    assert verdict.gaze is Gaze.OFF_ROAD and verdict.zone == "lap"
-    # lids closed from the start, the head on the road: the closure alone, no distraction
-    _, closed = run(between(2.0, 6.0, lid_down), 8.0)
-    assert "long_distraction:warning" not in kinds(closed)
-
-    # a closing lid pulls the eye reading down for a frame: shorter than a fixation
-    # (closed_glance_min_s, 0.1 s), so the closure is judged as one, with no distraction
-    def closing(t_s: float) -> tuple[float, EyesFeatures | None]:
-        if 2.0 <= t_s + 1e-9 < 2.0 + 1 / FPS:
-            return 0.0, down
-        if 2.0 + 1 / FPS <= t_s + 1e-9 < 6.0:
-            return 0.0, lid_down
-        return 0.0, eyes_of()
-
-    _, sleep = run(closing, 8.0)
-    assert kinds(sleep) == ["microsleep:warning", "sleep:critical", "cleared:info"]
-
-
 def test_unresponsive_when_not_back_three_seconds_after_a_vats_warning() -> None:
     # Mirror glances (driving-related: VATS counts them, long_distraction does not) add up to
     # 10 s; the fourth stays in the mirror 4 s past the VATS warning.

@@ -89,11 +89,6 @@ class EyeMonitorSettings(Section):
     and this many, by a ramp from 0 (firm shrinkage; infinite: the soft threshold, where every
     glance is shortened by the threshold). roadgaze's choice: twice the 10 deg deadband is 5.7
     standard deviations of the noisiest real clip's eye pitch, 3.5 deg (docs/eyes.md)."""
-    closed_glance_min_s: float | None = Field(default=0.1, ge=0)
-    """Lids that read closed keep an eyes-only glance's place (the lid follows a look down) only
-    when the eyes were seen open off the road this long first: a fixation, not the closing lid
-    itself, which pulls the eye reading down for a frame (67 ms at 15 fps in the rendered
-    closures; the glances held 0.13-0.40 s). None: a closure always drops the glance."""
     microsleep_s: float = Field(default=1.0, gt=0)
     sleep_s: float = Field(default=3.0, gt=0)
     unresponsive_closed_s: float = Field(default=6.0, gt=0)

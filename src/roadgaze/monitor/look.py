@@ -13,7 +13,7 @@ from roadgaze.monitor.lean import LEAN_ZONE, HeadPlace, leaning, step_place
 from roadgaze.monitor.neutral import NeutralPose
 from roadgaze.monitor.zones import AWAY, ROAD, ZoneMap
 from roadgaze.mounting import CameraMounting, gaze_to_driver
-from roadgaze.types import EyeStatus, EyesVerdict, Gaze, PoseSample
+from roadgaze.types import EyesVerdict, Gaze, PoseSample
 
 __all__ = ["Look", "classify", "finite", "to_driver_frame"]
 
@@ -69,9 +69,6 @@ class Look:
     """The yaw of the last sample with a usable yaw."""
     place: HeadPlace = field(default_factory=HeadPlace)
     """The head's place (body lean) and its learned driving place (roadgaze.monitor.lean)."""
-    eyes_off_since_s: float | None = None
-    """When the eyes began to take the gaze off the road (judged by the eyes, off road), None
-    when they do not: how long a glance was held before lids that read closed may keep it."""
     past_road_edge: bool = False
     """On the road by hysteresis only: the head is past the road's entry bound (its rectangle:
     `road_half_width_deg - hysteresis_deg` of yaw, `road_pitch_deg`), not yet past its exit
@@ -104,23 +101,6 @@ def _eyes_moved(eyes: EyesVerdict, head_yaw_deg: float, head_pitch_deg: float) -
     )
 
 
-def _closed_after_eye_glance(
-    config: MonitorConfig, previous: Look, eyes: EyesVerdict, head_zone: str, t_s: float
-) -> bool:
-    """The eyes read closed, the head on the road, and the previous sample was an eyes-only
-    glance off the road held `closed_glance_min_s` or more: the glance keeps its zone while
-    the lids read closed."""
-    since = previous.eyes_off_since_s
-    return (
-        config.closed_glance_min_s is not None
-        and eyes.status is EyeStatus.CLOSED
-        and head_zone == ROAD
-        and previous.zone is not None
-        and since is not None
-        and t_s - since >= config.closed_glance_min_s - 1e-9
-    )
-
-
 def classify(
     config: MonitorConfig,
     zones: ZoneMap,
@@ -145,24 +125,8 @@ def classify(
     if leaning(config, place.lean_m) and (zone == ROAD or zones.is_driving_related(zone)):
         gaze, zone, face_zone, by_eyes = Gaze.OFF_ROAD, LEAN_ZONE, LEAN_ZONE, False
     past_edge = zone == ROAD and yaw is not None and not zones.zones[0].contains(*turn)
-    eyes_off = by_eyes and gaze is Gaze.OFF_ROAD
-    eyes_since = None
-    if eyes_off:
-        previous_since = previous.eyes_off_since_s
-        eyes_since = sample.t_s if previous_since is None else previous_since
     return Look(
-        gaze,
-        zone,
-        face_zone,
-        yaw,
-        pitch,
-        lost_since,
-        turned,
-        by_eyes,
-        last_yaw,
-        place,
-        eyes_since,
-        past_edge,
+        gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes, last_yaw, place, past_edge
     )
 
 
@@ -204,20 +168,6 @@ def _judge(
                 ):
                     gaze = Gaze.ON_ROAD if gaze_zone == ROAD else Gaze.OFF_ROAD
                     return gaze, gaze_zone, gaze_zone, yaw, pitch, None, False, True
-            elif _closed_after_eye_glance(config, previous, eyes, zone, t_s):
-                # Lids that close during an eyes-only glance off the road keep its place: the
-                # lid follows a look down and may read closed (docs/eyes.md); the closure rules
-                # run as well, so nothing is hidden, and the distraction is not cut short.
-                return (
-                    Gaze.OFF_ROAD,
-                    previous.zone,
-                    previous.face_zone,
-                    yaw,
-                    pitch,
-                    None,
-                    False,
-                    True,
-                )
         gaze = Gaze.ON_ROAD if zone == ROAD else Gaze.OFF_ROAD
         return gaze, zone, zone, yaw, pitch, None, False, False
     if previous.lost_since_s is not None:

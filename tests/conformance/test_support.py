@@ -1,6 +1,9 @@
-"""How the conformance suite judges forward and lane support on a drive's logged changes."""
+"""How the conformance suite judges forward and lane support on a drive's logged changes, and a
+rendered look through the service."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import pytest
 
@@ -109,3 +112,35 @@ def test_support_after_a_warning_counts_an_output_already_heightened() -> None:
     changes = [("support_forward", "normal", 1.0), ("support_forward", "heightened", 2.0)]
     assert judge_support(FORWARD, 3.0, 7.0, changes) == (0.0, False)  # a glance's: not its own
     assert judge_support(FORWARD, 3.0, 7.0, changes, from_normal=False) == (0.0, True)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("road_edge", "in_time"), [(True, True), (False, False)])
+def test_a_mirror_look_under_a_beard_raises_support_at_the_road_edge_through_the_service(
+    tmp_path: Path, road_edge: bool, in_time: bool
+) -> None:
+    """Through the real service: the head 32 deg to the rear-view mirror under the rendered
+    beard reads about 23 deg (docs/pose.md, "Facial hair"), inside the road's exit bound (25);
+    support raised at its entry bound (`support_road_edge`) comes within 0.5 s (measured
+    0.40 s), at the zone's edge only it came at 1.27 s."""
+    from roadgaze.commands.conformance import FPS, SIZE
+    from roadgaze.config import Config
+    from roadgaze.conformance.clips import ScenarioRenderer
+    from roadgaze.conformance.dossier_general import under
+    from roadgaze.conformance.run import run_suite
+    from roadgaze.synth import EyeRenderer, load_photo
+
+    monitor = Config().monitor.model_copy(
+        update={"protocol": "euroncap", "support_road_edge": road_edge}
+    )
+    config = Config().model_copy(update={"monitor": monitor})
+    scenario = next(s for s in scenario_matrix(monitor) if s.name == "dt_owl_rear_view_mirror_70")
+    eyes = EyeRenderer(load_photo(), SIZE, config=config, eyeball_at_rest=True)
+    renderer = ScenarioRenderer(eyes, FPS, monitor.cabin)
+    suite = run_suite([under("beard")(scenario)], config, tmp_path, renderer)
+    forward = next(o for o in suite.outcomes if o.requirement.key.endswith(".support_forward"))
+    assert forward.passed is in_time
+    if in_time:
+        assert forward.measured_s is not None and forward.measured_s <= 0.5
+    else:
+        assert forward.measured_s is None or forward.measured_s > 0.5

@@ -139,7 +139,7 @@ def eye_zone_map(zones: ZoneMap, margin_deg: float) -> ZoneMap:
     """The zones for a gaze measured with the eyes: the road (the first zone) narrower by
     `margin_deg` on both sides in yaw and at its lower edge (never inverted); the upper edge and
     the other zones as they are (MediaPipe's eye pitch does not register upward gaze)."""
-    road = zones.zones[0]
+    road = zones.road
     yaw_half = max(0.0, 0.5 * (road.yaw_max_deg - road.yaw_min_deg) - margin_deg)
     yaw_mid = 0.5 * (road.yaw_max_deg + road.yaw_min_deg)
     pitch_min = min(road.pitch_min_deg + margin_deg, road.pitch_max_deg)

@@ -124,7 +124,7 @@ def classify(
     place = step_place(config, mounting, previous.place, sample, turn, zone == ROAD)
     if leaning(config, place.lean_m) and (zone == ROAD or zones.is_driving_related(zone)):
         gaze, zone, face_zone, by_eyes = Gaze.OFF_ROAD, LEAN_ZONE, LEAN_ZONE, False
-    past_edge = zone == ROAD and yaw is not None and not zones.zones[0].contains(*turn)
+    past_edge = zone == ROAD and yaw is not None and not zones.road.contains(*turn)
     return Look(
         gaze, zone, face_zone, yaw, pitch, lost_since, turned, by_eyes, last_yaw, place, past_edge
     )

@@ -170,6 +170,11 @@ class ZoneMap:
             )
 
     @property
+    def road(self) -> Zone:
+        """The road's rectangle (the first zone): its entry bound, before any hysteresis."""
+        return self.zones[0]
+
+    @property
     def names(self) -> tuple[str, ...]:
         """Every zone a sample can be given: the configured ones, then area 1's, then `away`."""
         return (*(zone.name for zone in self.zones), *AREA1_ZONES, LEAN, AWAY)

@@ -181,18 +181,6 @@ COARSE: frozenset[Version] = frozenset(("coarse", "wide"))
 """The versions then averaged over `COARSE_FACTOR` pixels square and scaled back."""
 
 
-def bilateral(
-    grey: npt.NDArray[np.uint8], levels: FrameLevels, version: Version = "strong"
-) -> npt.NDArray[np.uint8]:
-    """`grey` smoothed by `version`'s edge-preserving filter (`BILATERAL`), its colour sigma in
-    the frame's noise levels."""
-    import cv2
-
-    diameter, space_sigma, colour_sigma = BILATERAL[version]
-    sigma_colour = colour_sigma * levels.noise
-    return np.asarray(cv2.bilateralFilter(grey, diameter, sigma_colour, space_sigma), np.uint8)
-
-
 def _enhanced(
     image: npt.NDArray[np.uint8], version: Version = "curve"
 ) -> tuple[npt.NDArray[np.uint8], FrameLevels]:
@@ -202,7 +190,9 @@ def _enhanced(
     grey = _luminance(image)
     levels = assess(grey, noise=True)  # on the luminance (the decision read a colour's green)
     if levels.noise >= NOISY_LEVELS and version in BILATERAL:
-        grey = bilateral(grey, levels, version)
+        diameter, space_sigma, colour_sigma = BILATERAL[version]
+        sigma_colour = colour_sigma * levels.noise
+        grey = np.asarray(cv2.bilateralFilter(grey, diameter, sigma_colour, space_sigma), np.uint8)
     elif levels.noise >= NOISY_LEVELS:
         size = (SMOOTHING_KERNEL_PX, SMOOTHING_KERNEL_PX)
         grey = np.asarray(cv2.GaussianBlur(grey, size, 0), np.uint8)

@@ -37,8 +37,10 @@ from roadgaze.landmarks.front_end import (
     GRID_STEP,
     NOISY_LEVELS,
     SMOOTHING_KERNEL_PX,
+    STRONG_COLOUR_SIGMA,
+    STRONG_DIAMETER_PX,
+    STRONG_SPACE_SIGMA_PX,
     assess,
-    bilateral,
     tone_curve,
 )
 
@@ -77,7 +79,11 @@ def enhance_for_hands(image: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
     noisy = levels.noise >= NOISY_LEVELS
     smoothed = grey
     for _ in range(SMOOTHING_PASSES if noisy else 0):
-        smoothed = bilateral(smoothed, levels, "strong")
+        sigma_colour = STRONG_COLOUR_SIGMA * levels.noise
+        smoothed = np.asarray(
+            cv2.bilateralFilter(smoothed, STRONG_DIAMETER_PX, sigma_colour, STRONG_SPACE_SIGMA_PX),
+            np.uint8,
+        )
     lifted = np.asarray(cv2.LUT(smoothed, tone_curve(levels)), np.uint8)
     if colourless:
         return lifted

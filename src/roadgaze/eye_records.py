@@ -138,7 +138,8 @@ class EyesVerdict:
 
     status: EyeStatus = EyeStatus.UNAVAILABLE
     reason: str = ""
-    """Why the eyes are unavailable, or 'looking down' for narrowed lids read as a downward look."""
+    """Why the eyes are unavailable, or 'looking down' / 'looking aside' for narrowed lids read as
+    a glance (the head lowered; the iris read turned sideways)."""
     openness: float | None = None
     """The judged openness (lid aperture / eye width); None when not judged."""
     eye_yaw_deg: float | None = None

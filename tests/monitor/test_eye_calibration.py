@@ -5,6 +5,8 @@ nothing."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,7 @@ from roadgaze.monitor.eye_calibration import (
     EyeCalibration,
     eye_shift_deg,
     fail_safe_shift,
+    iris_aside,
     learn_calibration,
     thresholds_deg,
 )
@@ -62,6 +65,35 @@ def test_thresholds_are_the_deadband_or_sigmas_times_the_noise() -> None:
     assert thresholds_deg(CONFIG, quiet) == (10.0, 10.0)  # noise 1 deg: the deadband
     noisy = EyeCalibration(yaw_sq_deg2=4.0 * 4.0, pitch_sq_deg2=25.0 * 4.0, learned_s=4.0)
     assert thresholds_deg(CONFIG, noisy) == pytest.approx((10.0, 15.0))  # 3 x 5 deg in pitch
+
+
+def test_the_iris_is_aside_only_off_both_its_rest_and_the_eye_centre() -> None:
+    # A driver whose open eyes read 18 deg at rest (as the woman of the two-person clip): a
+    # shut lid reads near the centre (0..6) or near that rest (17), neither aside; 40 or -25 is.
+    biased = EyeCalibration(yaw_deg=18.0, learned_s=4.0, calibrated=True)
+    assert [iris_aside(CONFIG, biased, y) for y in (3.0, 10.0, 17.0, 29.0, 40.0, -25.0)] == [
+        False,
+        False,
+        False,
+        True,
+        True,
+        True,
+    ]
+    centred = EyeCalibration(yaw_deg=-3.0, learned_s=4.0, calibrated=True)
+    assert [iris_aside(CONFIG, centred, y) for y in (8.0, 12.0, -12.0, -14.0)] == [
+        False,
+        True,
+        False,
+        True,
+    ]
+    # The threshold is the driver's (3 sigma of a 5 deg noise: 15), not just the deadband.
+    noisy = EyeCalibration(yaw_sq_deg2=25.0 * 4.0, learned_s=4.0, calibrated=True)
+    assert (iris_aside(CONFIG, noisy, 14.0), iris_aside(CONFIG, noisy, 16.0)) == (False, True)
+    learning = EyeCalibration(yaw_deg=0.0, learned_s=1.0)
+    assert not iris_aside(CONFIG, learning, 40.0)
+    assert not iris_aside(CONFIG, centred, None) and not iris_aside(CONFIG, centred, math.nan)
+    off = MonitorConfig(closure_needs_centred_iris=False)
+    assert not iris_aside(off, centred, 40.0)
 
 
 def test_no_shift_until_calibrated_then_beyond_the_threshold_from_the_clamped_rest() -> None:

@@ -219,6 +219,28 @@ def test_a_closure_that_starts_with_the_head_up_stays_closed_when_the_head_drops
     assert events == [] and states[-1].verdict.reason == "looking down"
 
 
+def test_narrowed_lids_with_the_iris_read_aside_are_a_glance_not_a_closure() -> None:
+    # Calibrated at rest (yaw 0): lids at 0.08 with the eyes read 25 deg aside are a glance.
+    events, states = drive([(4.0, {}), (3.5, {"openness": 0.08, "eye_yaw": 25.0})])
+    assert not [kind for _, kind, _ in events if kind is AlertKind.MICROSLEEP]
+    assert states[-1].eyes.status is EyeStatus.OPEN and states[-1].verdict.reason == "looking aside"
+    # The same lids with the iris read in the middle (a shut lid's reading) are a closure.
+    events, _ = drive([(4.0, {}), (3.5, {"openness": 0.08, "eye_yaw": 6.0})])
+    assert AlertKind.MICROSLEEP in [kind for _, kind, _ in events]
+    # A closure that began centred stays one when the reading then slides aside.
+    events, states = drive(
+        [(4.0, {}), (0.5, {"openness": 0.08}), (2.0, {"openness": 0.08, "eye_yaw": 25.0})]
+    )
+    assert AlertKind.MICROSLEEP in [kind for _, kind, _ in events]
+    assert states[-1].eyes.status is EyeStatus.CLOSED
+    # Before the eyes are calibrated nothing is excused, and the setting turns the rule off.
+    events, _ = drive([(0.5, {}), (3.0, {"openness": 0.08, "eye_yaw": 25.0})])
+    assert AlertKind.MICROSLEEP in [kind for _, kind, _ in events]
+    off = MonitorConfig(closure_needs_centred_iris=False)
+    events, _ = drive([(4.0, {}), (3.5, {"openness": 0.08, "eye_yaw": 25.0})], config=off)
+    assert AlertKind.MICROSLEEP in [kind for _, kind, _ in events]
+
+
 def test_perclos_matches_the_closed_share_and_memory_stays_bounded() -> None:
     # 0.8 s open then 0.2 s closed (blinks, each shorter than the microsleep time): 20 %.
     config = MonitorConfig(long_blinks_drowsy=1000)

@@ -65,6 +65,12 @@ class EyeMonitorSettings(Section):
     look_down_head_deg: float = Field(default=4.0, gt=0)
     """Narrowed lids with the head this far below its road pitch (MediaPipe matrix pitch) read
     as looking down, not as closed."""
+    closure_needs_centred_iris: bool = True
+    """Lids that read closed while the eyes read turned sideways beyond the driver's yaw
+    threshold, from both their resting direction and the eye's centre, are narrowed for a glance
+    (open, "looking aside"), not shut: a shut lid's iris reads near one of the two (docs/eyes.md,
+    "Looking down vs closing the eyes"). Applies once the eyes are calibrated, never inside a
+    closure that began centred."""
     gaze_deadband_deg: float = Field(default=10.0, ge=0)
     """Eye-in-head deviations from the driver's resting eye direction below this count as none."""
     eyes_road_margin_deg: float = Field(default=5.0, ge=0)

@@ -37,6 +37,7 @@ __all__ = [
     "EyeCalibration",
     "eye_shift_deg",
     "fail_safe_shift",
+    "iris_aside",
     "learn_calibration",
     "thresholds_deg",
 ]
@@ -134,6 +135,22 @@ def thresholds_deg(config: MonitorConfig, calibration: EyeCalibration) -> tuple[
         max(config.gaze_deadband_deg, config.eye_noise_sigmas * yaw_noise),
         max(config.gaze_deadband_deg, config.eye_noise_sigmas * pitch_noise),
     )
+
+
+def iris_aside(
+    config: MonitorConfig, calibration: EyeCalibration, eye_yaw_deg: float | None
+) -> bool:
+    """Whether the eyes read turned sideways beyond the driver's yaw threshold both from their
+    resting yaw and from the eye's own centre (0): MediaPipe places a shut lid's iris near one
+    of the two (the eye's middle, or where that driver's open eyes read at rest), so an iris
+    read off both is seen, and lids that read closed are narrowed for a glance. False until
+    calibrated, without a yaw, or with `closure_needs_centred_iris` off."""
+    if not config.closure_needs_centred_iris or not calibration.calibrated:
+        return False
+    if eye_yaw_deg is None or not math.isfinite(eye_yaw_deg):
+        return False
+    threshold = thresholds_deg(config, calibration)[0]
+    return abs(eye_yaw_deg - calibration.yaw_deg) > threshold and abs(eye_yaw_deg) > threshold
 
 
 def eye_shift_deg(

@@ -85,12 +85,16 @@ def classify_eyes(
     head_below_road_deg: float | None,
     was_closed: bool | None = None,
     open_baseline: float | None = None,
+    iris_aside: bool = False,
 ) -> tuple[EyeStatus, str]:
     """Open, closed or unavailable, and why (module docstring).
 
     `head_below_road_deg`: how far the head's MediaPipe pitch lies below its road pitch (> 0 =
     lowered; None unknown). `was_closed`: the previous decision (None: none yet).
     `open_baseline`: the driver's learned open-eye openness (None: the population's).
+    `iris_aside`: the eyes read turned sideways off their rest and centre
+    (`roadgaze.monitor.eye_calibration.iris_aside`): lids that begin to read closed then are
+    narrowed for a glance ("looking aside").
     """
     if eyes is None:
         return EyeStatus.UNAVAILABLE, "no eyes measured"
@@ -115,6 +119,8 @@ def classify_eyes(
         return EyeStatus.OPEN, ""
     if head_below_road_deg is not None and head_below_road_deg > config.look_down_head_deg:
         return EyeStatus.OPEN, "looking down"
+    if iris_aside:
+        return EyeStatus.OPEN, "looking aside"
     return _judgeable_closure(config, eyes, factor)
 
 

@@ -8,7 +8,10 @@ Definitions (thresholds in `MonitorConfig`; defaults and sources in docs/monitor
   closed when o < `eyes_hard_close_below`, or o < `eyes_close_below` and b >= `eyes_blink_min`;
   once closed, open again only above `eyes_open_above`. Narrowed lids with the head lowered more
   than `look_down_head_deg` read as *looking down* (open: from a camera in front, the open eyes of
-  a lowered head look closed), unless the closure began with the head up. Both thresholds scale
+  a lowered head look closed), unless the closure began with the head up; so do narrowed lids
+  with the iris read turned sideways off both its calibrated rest and the eye's centre, as
+  *looking aside* (`iris_aside`: a shut lid's iris reads near one of them), unless the closure
+  began with it centred. Both thresholds scale
   with the driver's learned open-eye openness (factor 0.7-1.3 of the population's 0.30).
 - **Unavailable**: no face, no eye that can be judged (a turned head, small eyes, low landmark
   quality), or the eyes hidden (sunglasses). Up to `closure_gap_s` of it inside a closure does
@@ -39,7 +42,12 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from roadgaze.config import MonitorConfig
-from roadgaze.monitor.eye_calibration import EyeCalibration, eye_shift_deg, learn_calibration
+from roadgaze.monitor.eye_calibration import (
+    EyeCalibration,
+    eye_shift_deg,
+    iris_aside,
+    learn_calibration,
+)
 from roadgaze.monitor.eye_rules import POPULATION_OPEN, classify_eyes, gaze_deg, soft_threshold
 from roadgaze.types import AlertKind, EyesFeatures, EyeStatus, EyesVerdict, PoseSample
 
@@ -215,7 +223,8 @@ def _judge(
         else state.road_pitch_deg - mp_pitch
     )
     was_closed = state.status is EyeStatus.CLOSED if state.judged_at_s is not None else None
-    status, reason = classify_eyes(config, eyes, below, was_closed, state.open_baseline)
+    aside = eyes is not None and iris_aside(config, state.calibration, eyes.yaw_deg)
+    status, reason = classify_eyes(config, eyes, below, was_closed, state.open_baseline, aside)
     if not sample.face:
         reason = "no face"
     judged_at = state.judged_at_s

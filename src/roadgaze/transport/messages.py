@@ -37,7 +37,7 @@ class EyeFields(_Message):
         default=EyeStatus.UNAVAILABLE, description="open, closed or unavailable"
     )
     eyes_reason: str = Field(
-        default="", description="Why unavailable, or 'looking down' for narrowed lids."
+        default="", description="Why unavailable, or why narrowed lids are open."
     )
     eye_openness: float | None = Field(
         default=None, description="Lid gap / eye width (about 0.3 open, 0.1 closed)."

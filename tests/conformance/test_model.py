@@ -70,3 +70,21 @@ def test_a_requirement_that_does_not_apply_passes_and_says_so() -> None:
     other = Requirement("r", "t", "s", ("vats",), (1.0, 2.0), "look", applies=False)
     assert judge(other, 0.0, []) == (None, True)
     assert Outcome("s", other, None, True).to_json()["result"] == "N/A"
+
+
+def test_a_requirement_of_another_protocol_is_never_counted_failed() -> None:
+    from roadgaze.conformance.model import Outcome
+    from roadgaze.conformance.report import summary_line
+    from roadgaze.conformance.run import SuiteRun
+
+    other = Requirement("o", "t", "s", ("phone_use",), (1.0, 2.0), "look", applies=False)
+    mine = Requirement("m", "t", "s", ("long_distraction",), (1.0, 2.0), "look")
+    outcomes = (
+        Outcome("a", other, None, False),  # not warned, but not this protocol's to judge
+        Outcome("a", mine, 1.5, True),
+        Outcome("b", mine, None, False),
+    )
+    run = SuiteRun(outcomes, 2, 1.0)
+    assert [o.scenario for o in run.failed] == ["b"]
+    line = summary_line(run, "addw")
+    assert line.startswith("protocol addw: 1 of 2 requirements PASS, 1 FAIL, 1 of other")

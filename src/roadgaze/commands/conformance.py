@@ -112,7 +112,7 @@ def run(args: argparse.Namespace, config: Config) -> int:
     renderer = ScenarioRenderer(eyes, FPS, config.monitor.cabin)
 
     def progress(scenario: Any, outcomes: list[Any]) -> None:
-        verdict = "PASS" if all(o.passed for o in outcomes) else "FAIL"
+        verdict = "FAIL" if any(o.result == "FAIL" for o in outcomes) else "PASS"
         measured = ", ".join(
             f"{o.requirement.key.rpartition('.')[2]} "
             + ("none" if o.measured_s is None else f"{o.measured_s:.2f} s")

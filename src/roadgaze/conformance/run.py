@@ -106,7 +106,8 @@ class SuiteRun:
 
     @property
     def failed(self) -> tuple[Outcome, ...]:
-        return tuple(outcome for outcome in self.outcomes if not outcome.passed)
+        """The requirements that apply and failed (one of another protocol is N/A, not FAIL)."""
+        return tuple(outcome for outcome in self.outcomes if outcome.result == "FAIL")
 
 
 def run_suite(

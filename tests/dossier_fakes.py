@@ -56,6 +56,12 @@ def failing_under(*conditions: str, scenario: str = "mirror_left_70") -> set[str
     return {f"{scenario}__{condition}" for condition in conditions}
 
 
+def failing_everything_under(*conditions: str) -> set[str]:
+    """Every scenario of the euroncap matrix under each of `conditions`: a `FakeRunner` failing
+    these leaves no GREEN cell standing under a mandatory one (so it is not shown functional)."""
+    return {f"{s.name}__{condition}" for s in euroncap_scenarios() for condition in conditions}
+
+
 MANDATORY = ("night", "clear_sunglasses", "stubble", "beard", "mask")
 """The conditions of the five mandatory noise variables."""
 NOTICES = ("hand_at_12", "cap", "hat", "fringe", "eyelash_makeup")

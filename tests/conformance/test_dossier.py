@@ -11,6 +11,7 @@ from dossier_fakes import (
     NOTICES,
     FakeRunner,
     euroncap_scenarios,
+    failing_everything_under,
     failing_under,
     outcomes_of,
 )
@@ -76,17 +77,45 @@ def test_a_right_hand_drive_cabin_swaps_the_driver_and_passenger_sides() -> None
 
 
 def test_noise_variables_are_functional_only_when_every_green_cell_passes_under_them() -> None:
-    runner = FakeRunner(failing=failing_under("night"))
+    runner = FakeRunner(failing=failing_under("hat"))
     dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
     sunglasses = dossier.noise_of("Dark sunglasses")
     assert sunglasses is not None and sunglasses.performance == "Functional"
     green = {key.split(".")[0] for c in dossier.cells if c.colour == GREEN for key in c.keys}
     ran = [name for name in runner.calls if name.endswith("__dark_sunglasses")]
     assert {name.removesuffix("__dark_sunglasses") for name in ran} == green
-    night = dossier.noise_of("Daytime - Night-time")
-    assert night is not None and night.performance == "Non Functional"
-    assert [name for name in runner.calls if name.endswith("__night")] == ["mirror_left_70__night"]
+    hat = dossier.noise_of("Hat")
+    assert hat is not None and hat.performance == "Non Functional"
+    assert [name for name in runner.calls if name.endswith("__hat")] == ["mirror_left_70__hat"]
     assert all(n.variable.variant is not None for n in dossier.noise)
+
+
+def test_a_cell_failing_under_a_mandatory_noise_variable_is_not_claimed() -> None:
+    # The mirror look fails at night: its cells turn RED, saying why, and night stays
+    # Functional for every cell still GREEN (each scenario was run under it, not just the first).
+    runner = FakeRunner(failing=failing_under("night"))
+    plain = judge_cells(outcomes_by_key(outcomes_of(SCENARIOS)), "lhd")
+    dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
+    turned = [(a, b) for a, b in zip(plain, dossier.cells, strict=True) if a.colour != b.colour]
+    assert turned and all(b.colour == RED for _, b in turned)
+    assert {k.split(".")[0] for _, b in turned for k in b.keys} >= {"mirror_left_70"}
+    assert all(
+        "RED under Daytime - Night-time (mandatory): FAIL: mirror_left_70." in b.why
+        for _, b in turned
+    )
+    assert all(a.why in b.why for a, b in turned)  # the plain run's PASS is kept in the why
+    night = dossier.noise_of("Daytime - Night-time")
+    assert night is not None and night.performance == "Functional"
+    assert night.why.startswith("PASS: ")
+    ran = [n.removesuffix("__night") for n in runner.calls if n.endswith("__night")]
+    assert set(ran) == {k.split(".")[0] for c in plain if c.colour == GREEN for k in c.keys}
+    assert len(ran) == len(set(ran))  # run once: the noise table reads the same outcomes
+    # Failing everything at night leaves no GREEN cell: night is not shown functional.
+    everything = FakeRunner(failing=failing_everything_under("night"))
+    dark = judge(outcomes_of(SCENARIOS), SCENARIOS, everything, "lhd")
+    assert not any(c.colour == GREEN for c in dark.cells)
+    night = dark.noise_of("Daytime - Night-time")
+    assert night is not None and night.why == "no GREEN cell to show it on"
 
 
 def test_a_noise_variable_stops_at_the_first_scenario_failing_under_it() -> None:
@@ -102,7 +131,8 @@ def test_a_noise_variable_stops_at_the_first_scenario_failing_under_it() -> None
 
 def test_general_requirements_answer_pass_fail_or_na_with_their_basis() -> None:
     outcomes = outcomes_of(SCENARIOS, failed=("lap_70.warns", notice_key("hat")))
-    runner = FakeRunner(failing=failing_under("cap", "hat"))
+    cap_fails = failing_under("cap", scenario="side_left_70")
+    runner = FakeRunner(failing=cap_fails | failing_under("hat"))
     dossier = judge(outcomes, SCENARIOS, runner, "lhd")
     answers = {g.requirement.text: g for g in dossier.general}
     assert answers["Default ON at the start of every journey"].value == "FAIL"
@@ -114,12 +144,35 @@ def test_general_requirements_answer_pass_fail_or_na_with_their_basis() -> None:
     cap = next(g for text, g in answers.items() if text.endswith("wears a cap"))
     assert cap.value == "PASS"  # the cap not shown functional: its notice was measured
     assert cap.why.startswith("the service raised `non_functional` within 10 s")
+    # No notice under a hat: Non Functional, the hat would hold the score at 0, so the cells
+    # failing under it (the mirror look) are not claimed and the hat is shown Functional.
+    hat = next(g for text, g in answers.items() if text.endswith("wears a hat"))
+    assert hat.value == "N/A"
+    mirror = [c for c in dossier.cells if any(k.startswith("mirror_left_70.") for k in c.keys)]
+    assert mirror and all(c.colour == RED for c in mirror)
+    assert all("RED under Hat (no notice given): FAIL: mirror_left_70." in c.why for c in mirror)
+    # With nothing left to claim under the hat, it is Non Functional and its notice FAILs.
+    everything = FakeRunner(failing=failing_everything_under("hat"))
+    answers = {g.requirement.text: g for g in judge(outcomes, SCENARIOS, everything, "lhd").general}
     hat = next(g for text, g in answers.items() if text.endswith("wears a hat"))
     assert hat.value == "FAIL" and hat.why.startswith("FAIL: notice_hat_70.told")
 
 
+def test_a_notice_not_run_does_not_hold_the_cells_under_its_condition() -> None:
+    # Without the hat's notice scenario (--only), nothing says whether a notice is given: the
+    # mirror look failing under the hat keeps its cells, and the hat is Non Functional.
+    outcomes = [o for o in outcomes_of(SCENARIOS) if o.scenario != "notice_hat_70"]
+    dossier = judge(outcomes, SCENARIOS, FakeRunner(failing=failing_under("hat")), "lhd")
+    mirror = [c for c in dossier.cells if any(k.startswith("mirror_left_70.") for k in c.keys)]
+    assert mirror and all(c.colour == GREEN for c in mirror)
+    hat = dossier.noise_of("Hat")
+    assert hat is not None and hat.performance == "Non Functional"
+    told = {g.requirement.label: g for g in dossier.general}["notice: hat"]
+    assert told.value == "FAIL" and told.why.startswith("not run: notice_hat_70.told")
+
+
 def test_the_gates_name_what_holds_the_score_and_can_be_taken_as_met() -> None:
-    runner = FakeRunner(failing=failing_under(*MANDATORY, *NOTICES))
+    runner = FakeRunner(failing=failing_everything_under(*MANDATORY) | failing_under(*NOTICES))
     dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
     gates = dossier.gates()
     assert gates[0] == (

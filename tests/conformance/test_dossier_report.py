@@ -5,7 +5,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from dossier_fakes import MANDATORY, FakeRunner, euroncap_scenarios, failing_under, outcomes_of
+from dossier_fakes import (
+    MANDATORY,
+    FakeRunner,
+    euroncap_scenarios,
+    failing_everything_under,
+    outcomes_of,
+)
 from repo_paths import REPO
 from roadgaze.config import Config
 from roadgaze.conformance.dossier import judge
@@ -46,7 +52,7 @@ def test_the_measured_sheet_shows_each_cell_with_what_was_measured() -> None:
 
 
 def test_the_score_is_one_line_followed_by_its_categories_gates_and_assumptions() -> None:
-    runner = FakeRunner(failing=failing_under(*MANDATORY))
+    runner = FakeRunner(failing=failing_everything_under(*MANDATORY))
     dossier = judge(outcomes_of(SCENARIOS), SCENARIOS, runner, "lhd")
     official = Scored(Score(0.0, 25.0, (("Non-transient - Sleep", 0.0, 2.0),)), (), (), Path("r"))
     alone = Score(3.0, 25.0, (("Non-transient - Sleep", 0.5, 2.0), ("Phone use", 0.0, 5.0)))

@@ -77,7 +77,8 @@ def test_a_template_not_as_expected_is_one_line_naming_what_was_found(
 
 def test_the_filled_sheet_holds_the_dossiers_values(tmp_path: Path) -> None:
     scenarios = euroncap_scenarios()
-    runner = FakeRunner(failing=failing_under("dark_sunglasses", "night"))
+    dark = failing_under("dark_sunglasses", scenario="side_left_70")
+    runner = FakeRunner(failing=failing_under("night") | dark)
     dossier = judge(outcomes_of(scenarios, failed=("sleep_70.warns",)), scenarios, runner, "lhd")
     out = write_dossier(template(), dossier, tmp_path / "d.xlsx")
     ws = openpyxl.load_workbook(out)[SHEET]
@@ -91,11 +92,15 @@ def test_the_filled_sheet_holds_the_dossiers_values(tmp_path: Path) -> None:
         "Green",  # drowsiness
         "Red",  # non-fatigue impairment: nothing detects it
     ]
-    assert ws["D2"].value == "Non Functional" and ws["D4"].value == "Non Functional"
+    # The mirror look failed at night (mandatory): its row 39 is not claimed, and night is
+    # Functional for every cell left GREEN; under dark sunglasses (not mandatory) a look failed.
+    assert [ws[c].value for c in ("E39", "F39")] == ["Red", "Red"]
+    assert ws["D2"].value == "Functional" and ws["D4"].value == "Non Functional"
     assert ws["D3"].value == "Functional"  # clear sunglasses: every GREEN cell passed under them
     greens = sum(c.value == "Green" for row in ws["D17:F72"] for c in row)
     # 31 warnings (rows 17-25, 35-38, 47, 51-64, 68, 70 and 72's emergency function; sleep_70
     # failed), forward and lane support of rows 17-31, 35-47 (the driving-task looks included)
-    # and 51-64, and the non-transient support of drowsiness, microsleep and sleep
-    assert greens == sum(c.colour == "Green" for c in dossier.cells) == 31 + 42 * 2 + 3
+    # and 51-64, and the non-transient support of drowsiness, microsleep and sleep; less row
+    # 39's two (the mirror look, failed at night)
+    assert greens == sum(c.colour == "Green" for c in dossier.cells) == 31 + 42 * 2 + 3 - 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d.xlsx"]

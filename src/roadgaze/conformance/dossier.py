@@ -1,8 +1,11 @@
 """The Euro NCAP driver-monitoring dossier judged from a conformance run: each cell of the
-prediction sheet GREEN only where every requirement behind it was measured passing, each noise
+prediction sheet GREEN only where every requirement behind it was measured passing, as rendered
+and again under every noise variable that must be Functional for a score at all (the mandatory
+ones, and those whose non-functional notice the service did not give), each other noise
 variable Functional only where every GREEN cell also passed under it, each general requirement
-answered with its basis. Pure: the scenarios that must be run again (under a noise variable, or
-for the calculator's verification) go through a `Runner` the caller gives.
+answered with its basis. Pure: the scenarios that must be
+run again (under a noise variable, or for the calculator's verification) go through a `Runner`
+the caller gives.
 
 The table of rows, noise variables and general requirements: `roadgaze.conformance.dossier_rows`;
 the workbook: `dossier_xlsx`; the official calculator: `dossier_score`.
@@ -11,7 +14,7 @@ the workbook: `dossier_xlsx`; the official calculator: `dossier_score`.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from roadgaze.conformance.dossier_rows import (
     CELL_COLUMNS,
@@ -165,12 +168,67 @@ def run_under(
     return verdict(keys, results)
 
 
+def _green_keys(cells: Sequence[Cell]) -> tuple[str, ...]:
+    return tuple(dict.fromkeys(k for c in cells if c.colour == GREEN for k in c.keys))
+
+
+def must_hold(variable: NoiseVariable, results: dict[str, Outcome]) -> str:
+    """Why every GREEN cell must pass under `variable` ("": it may be Non Functional): it is
+    mandatory, or it asks for a non-functional notice and the run measured none (Non Functional,
+    it would then fail that general requirement; a notice scenario not run says nothing).
+    Either way the calculator would score 0."""
+    if variable.mandatory:
+        return "mandatory"
+    notices = [r for r in GENERAL_REQUIREMENTS if r.noise == variable.element and r.evidence]
+    measured = [r for r in notices if all(key in results for key in r.evidence)]
+    if any(not verdict(r.evidence, results)[0] for r in measured):
+        return "no notice given"
+    return ""
+
+
+def hold_under_required(
+    cells: Sequence[Cell],
+    scenarios: Sequence[Scenario],
+    runner: Runner,
+    results: dict[str, Outcome],
+) -> tuple[tuple[Cell, ...], dict[str, dict[str, Outcome]]]:
+    """The cells with every GREEN one that fails under a noise variable that `must_hold` turned
+    RED (saying under which, and why it must hold), and each such variable's outcomes: every
+    scenario behind a GREEN cell run again under it (not stopping at the first failure). A row
+    the system meets only outside a condition it must work in is not claimed, as a carmaker
+    would not claim it: claimed, the condition would score 0."""
+    judged: tuple[Cell, ...] = tuple(cells)
+    measured: dict[str, dict[str, Outcome]] = {}
+    for variable in NOISE_VARIABLES:
+        reason = must_hold(variable, results)
+        if not reason or variable.variant is None:
+            continue
+        chosen = sorted(scenarios_of(_green_keys(judged), scenarios), key=lambda s: s.duration_s)
+        again: dict[str, Outcome] = {}
+        for scenario in chosen:
+            again.update(outcomes_by_key(runner([variable.variant(scenario)])))
+        measured[variable.element] = again
+        held = []
+        for cell in judged:
+            passed, why = (True, "") if cell.colour != GREEN else verdict(cell.keys, again)
+            if not passed:
+                under = f"RED under {variable.element} ({reason}): {why}"
+                cell = replace(cell, colour=RED, why=f"{cell.why}; {under}")
+            held.append(cell)
+        judged = tuple(held)
+    return judged, measured
+
+
 def judge_noise(
-    cells: Sequence[Cell], scenarios: Sequence[Scenario], runner: Runner
+    cells: Sequence[Cell],
+    scenarios: Sequence[Scenario],
+    runner: Runner,
+    measured: dict[str, dict[str, Outcome]] | None = None,
 ) -> tuple[NoiseVerdict, ...]:
     """Each noise variable: Functional only where every GREEN cell's requirements pass again
-    with the scenarios rendered under it."""
-    green_keys = tuple(dict.fromkeys(k for c in cells if c.colour == GREEN for k in c.keys))
+    with the scenarios rendered under it. `measured`: outcomes already run under a variable (by
+    `hold_under_required`), judged instead of running again."""
+    green_keys = _green_keys(cells)
     verdicts = []
     for variable in NOISE_VARIABLES:
         if variable.variant is None:
@@ -178,6 +236,9 @@ def judge_noise(
             verdicts.append(NoiseVerdict(variable, False, why))
         elif not green_keys:
             verdicts.append(NoiseVerdict(variable, False, "no GREEN cell to show it on"))
+        elif measured is not None and variable.element in measured:
+            passed, why = verdict(green_keys, measured[variable.element])
+            verdicts.append(NoiseVerdict(variable, passed, why))
         else:
             passed, why = run_under(green_keys, variable, scenarios, runner)
             verdicts.append(NoiseVerdict(variable, passed, why))
@@ -210,10 +271,11 @@ def judge(
     outcomes: Iterable[Outcome], scenarios: Sequence[Scenario], runner: Runner, cabin: str
 ) -> Dossier:
     """The dossier of a conformance run (`outcomes` of `scenarios`, in a `cabin`); scenarios
-    are run again under each noise variable roadgaze can render."""
+    are run again under each noise variable roadgaze can render, a GREEN cell kept only where
+    it passes under every one that must hold (`hold_under_required`)."""
     results = outcomes_by_key(outcomes)
-    cells = judge_cells(results, cabin)
-    noise = judge_noise(cells, scenarios, runner)
+    cells, measured = hold_under_required(judge_cells(results, cabin), scenarios, runner, results)
+    noise = judge_noise(cells, scenarios, runner, measured)
     return Dossier(cells, noise, judge_general(results, noise), cabin)
 
 

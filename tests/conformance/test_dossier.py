@@ -4,6 +4,8 @@ requirements answered with their basis (`roadgaze.conformance.dossier`)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from dossier_fakes import (
@@ -23,6 +25,7 @@ from roadgaze.conformance.dossier import (
     outcomes_by_key,
     with_gates_met,
 )
+from roadgaze.conformance.model import Outcome
 from roadgaze.conformance.notices import notice_key
 
 SCENARIOS = euroncap_scenarios()
@@ -169,6 +172,31 @@ def test_a_notice_not_run_does_not_hold_the_cells_under_its_condition() -> None:
     assert hat is not None and hat.performance == "Non Functional"
     told = {g.requirement.label: g for g in dossier.general}["notice: hat"]
     assert told.value == "FAIL" and told.why.startswith("not run: notice_hat_70.told")
+
+
+def test_the_activation_speed_passes_only_when_the_rules_are_active_at_every_speed() -> None:
+    label = "speed activation of distraction, microsleep, sleep, unresponsive"
+    # Configured active from 0 km/h, the 8 s lap look at 10 km/h warns: any figure is met.
+    slow = [o for o in outcomes_of(SCENARIOS) if o.requirement.key != "lap_8s_10.quiet"]
+    quiet = next(o for o in outcomes_of(SCENARIOS) if o.requirement.key == "lap_8s_10.quiet")
+    warned = replace(quiet, measured_s=3.2, passed=False)
+
+    def answer(outcomes: list[Outcome], min_speed_kmh: float | None) -> tuple[str, str]:
+        dossier = judge(outcomes, SCENARIOS, FakeRunner(), "lhd", min_speed_kmh)
+        verdict = {g.requirement.label: g for g in dossier.general}[label]
+        return verdict.value, verdict.why
+
+    value, why = answer([*slow, warned], 0.0)
+    assert value == "PASS" and why.startswith("min_speed_kmh 0: the rules are active at every")
+    assert why.endswith("(lap_8s_10 warned 3.20 s into its look)")
+    # The default 20 km/h, an unknown setting, or a slow look that stayed quiet: not shown.
+    for outcomes, min_speed in (
+        ([*slow, warned], 20.0),
+        ([*slow, warned], None),
+        ([*slow, quiet], 0.0),
+    ):
+        value, why = answer(outcomes, min_speed)
+        assert value == "FAIL" and why.startswith("the protocol's activation speed was not read")
 
 
 def test_the_gates_name_what_holds_the_score_and_can_be_taken_as_met() -> None:

@@ -185,7 +185,7 @@ def _dossier(
         return [outcome for scenario in batch for outcome in runs[scenario.name]]
 
     scenarios = scenario_matrix(config.monitor)
-    dossier = judge(outcomes, scenarios, runner, config.monitor.cabin)
+    dossier = judge(outcomes, scenarios, runner, config.monitor.cabin, config.monitor.min_speed_kmh)
     log_written(write_dossier(template, dossier, args.dossier))
     markdown = dossier_markdown(dossier)
     print(f"\n{markdown}", flush=True)

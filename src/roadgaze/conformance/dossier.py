@@ -245,14 +245,32 @@ def judge_noise(
     return tuple(verdicts)
 
 
+def _every_speed(key: str, results: dict[str, Outcome], min_speed_kmh: float | None) -> str:
+    """Why the rules are shown active at every forward speed ("": not shown)."""
+    slow = results.get(key)
+    if min_speed_kmh != 0 or slow is None or slow.measured_s is None:
+        return ""
+    return (
+        "min_speed_kmh 0: the rules are active at every forward speed, so at the protocol's "
+        f"activation speed whatever it is ({slow.scenario} warned {slow.measured_s:.2f} s into "
+        "its look)"
+    )
+
+
 def judge_general(
-    results: dict[str, Outcome], noise: Sequence[NoiseVerdict]
+    results: dict[str, Outcome],
+    noise: Sequence[NoiseVerdict],
+    min_speed_kmh: float | None = None,
 ) -> tuple[GeneralVerdict, ...]:
-    """Each general requirement answered (see `GeneralRequirement`)."""
+    """Each general requirement answered (see `GeneralRequirement`); `min_speed_kmh`: the
+    configured activation speed of the Euro NCAP rules (None: not known)."""
     functional = {n.variable.element for n in noise if n.functional}
     verdicts = []
     for requirement in GENERAL_REQUIREMENTS:
-        if requirement.noise and requirement.noise in functional:
+        every = _every_speed(requirement.every_speed, results, min_speed_kmh)
+        if every:
+            verdicts.append(GeneralVerdict(requirement, "PASS", every))
+        elif requirement.noise and requirement.noise in functional:
             why = f"{requirement.noise} is Functional: nothing to inform of"
             verdicts.append(GeneralVerdict(requirement, "N/A", why))
         elif requirement.evidence:
@@ -268,15 +286,20 @@ def judge_general(
 
 
 def judge(
-    outcomes: Iterable[Outcome], scenarios: Sequence[Scenario], runner: Runner, cabin: str
+    outcomes: Iterable[Outcome],
+    scenarios: Sequence[Scenario],
+    runner: Runner,
+    cabin: str,
+    min_speed_kmh: float | None = None,
 ) -> Dossier:
     """The dossier of a conformance run (`outcomes` of `scenarios`, in a `cabin`); scenarios
     are run again under each noise variable roadgaze can render, a GREEN cell kept only where
-    it passes under every one that must hold (`hold_under_required`)."""
+    it passes under every one that must hold (`hold_under_required`). `min_speed_kmh`: the
+    configured activation speed of the Euro NCAP rules (`judge_general`)."""
     results = outcomes_by_key(outcomes)
     cells, measured = hold_under_required(judge_cells(results, cabin), scenarios, runner, results)
     noise = judge_noise(cells, scenarios, runner, measured)
-    return Dossier(cells, noise, judge_general(results, noise), cabin)
+    return Dossier(cells, noise, judge_general(results, noise, min_speed_kmh), cabin)
 
 
 def with_gates_met(dossier: Dossier) -> Dossier:

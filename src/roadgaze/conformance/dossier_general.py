@@ -71,7 +71,10 @@ class GeneralRequirement:
     own words, and how roadgaze answers it: PASS when every `evidence` key passed; without
     evidence, PASS on `basis` (a property of the service) or on `integrator` (the vehicle's
     part, taken as met and printed with the score); N/A when `noise` names a noise variable
-    the dossier states Functional; otherwise FAIL, `missing` saying what is not there."""
+    the dossier states Functional; PASS when `every_speed` names a slow scenario that warned
+    while the rules are configured active at every forward speed (`min_speed_kmh` 0: active at
+    the protocol's activation speed, whatever it is); otherwise FAIL, `missing` saying what is
+    not there."""
 
     text: str
     label: str
@@ -81,6 +84,7 @@ class GeneralRequirement:
     integrator: str = ""
     noise: str = ""
     missing: str = ""
+    every_speed: str = ""
 
 
 _INFORM = "Inform with visual and/or auditory cues of non functional system within 10 seconds"
@@ -135,6 +139,7 @@ GENERAL_REQUIREMENTS: tuple[GeneralRequirement, ...] = (
         "speed activation of distraction, microsleep, sleep, unresponsive",
         missing="the protocol's activation speed was not read here; roadgaze's 20 km/h "
         "(min_speed_kmh) is its own choice",
+        every_speed="lap_8s_10.quiet",
     ),
     GeneralRequirement(
         "Speed activation condition for the impairment driver states, when the vehicle is moving "

@@ -3,9 +3,8 @@ prediction sheet GREEN only where every requirement behind it was measured passi
 and again under every noise variable that must be Functional for a score at all (the mandatory
 ones, and those whose non-functional notice the service did not give), each other noise
 variable Functional only where every GREEN cell also passed under it, each general requirement
-answered with its basis. Pure: the scenarios that must be
-run again (under a noise variable, or for the calculator's verification) go through a `Runner`
-the caller gives.
+answered with its basis. Pure: the scenarios that must be run again (under a noise variable,
+or for the calculator's verification) go through a `Runner` the caller gives.
 
 The table of rows, noise variables and general requirements: `roadgaze.conformance.dossier_rows`;
 the workbook: `dossier_xlsx`; the official calculator: `dossier_score`.
@@ -147,6 +146,11 @@ def scenarios_of(keys: Iterable[str], scenarios: Sequence[Scenario]) -> list[Sce
     return [s for s in scenarios if any(r.key in wanted for r in s.requirements)]
 
 
+def _shortest_first(keys: Iterable[str], scenarios: Sequence[Scenario]) -> list[Scenario]:
+    """The scenarios behind `keys`, the shortest drive first (a failure shows soonest)."""
+    return sorted(scenarios_of(keys, scenarios), key=lambda s: s.duration_s)
+
+
 def run_under(
     keys: tuple[str, ...],
     noise: NoiseVariable | None,
@@ -157,9 +161,8 @@ def run_under(
     the shortest drive first, stopping at the first that fails; (passed, why)."""
     if noise is not None and noise.variant is None:
         return False, f"roadgaze cannot render {noise.element!r} yet"
-    chosen = sorted(scenarios_of(keys, scenarios), key=lambda s: s.duration_s)
     results: dict[str, Outcome] = {}
-    for scenario in chosen:
+    for scenario in _shortest_first(keys, scenarios):
         run = scenario if noise is None or noise.variant is None else noise.variant(scenario)
         results.update(outcomes_by_key(runner([run])))
         passed, why = verdict(tuple(k for k in keys if k in results), results)
@@ -203,9 +206,8 @@ def hold_under_required(
         reason = must_hold(variable, results)
         if not reason or variable.variant is None:
             continue
-        chosen = sorted(scenarios_of(_green_keys(judged), scenarios), key=lambda s: s.duration_s)
         again: dict[str, Outcome] = {}
-        for scenario in chosen:
+        for scenario in _shortest_first(_green_keys(judged), scenarios):
             again.update(outcomes_by_key(runner([variable.variant(scenario)])))
         measured[variable.element] = again
         held = []

@@ -11,8 +11,8 @@ Definitions (thresholds in `MonitorConfig`; defaults and sources in docs/monitor
   a lowered head look closed), unless the closure began with the head up; so do narrowed lids
   with the iris read turned sideways off both its calibrated rest and the eye's centre, as
   *looking aside* (`iris_aside`: a shut lid's iris reads near one of them), unless the closure
-  began with it centred. Both thresholds scale
-  with the driver's learned open-eye openness (factor 0.7-1.3 of the population's 0.30).
+  began with it centred. Both thresholds scale with the driver's learned open-eye openness
+  (factor 0.7-1.3 of the population's 0.30).
 - **Unavailable**: no face, no eye that can be judged (a turned head, small eyes, low landmark
   quality), or the eyes hidden (sunglasses). Up to `closure_gap_s` of it inside a closure does
   not end the closure.

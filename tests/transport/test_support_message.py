@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import threading
 from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
 import jsonschema
@@ -98,8 +99,17 @@ def test_without_a_verdict_support_is_heightened() -> None:
     assert vss_values(bare, CONFIG)[SUPPORT_PATHS["lane"]] is True
 
 
-def test_a_zenoh_subscriber_receives_support_and_the_state_carries_it() -> None:
+def test_a_zenoh_subscriber_receives_support_and_the_state_carries_it(tmp_path: Path) -> None:
+    """Support is put with congestion control DROP: Zenoh drops a message its queue cannot take
+    within `wait_before_drop` (1 ms by default), which a loaded CI machine once reached (fewer
+    than 5 frames arrived in 10 s). The daemon accepts that (the next frame says it again); this test checks
+    the routing, so its session waits up to 1 s instead."""
     port = free_port()
+    patient = tmp_path / "zenoh.json5"
+    patient.write_text(
+        '{"transport": {"link": {"tx": {"queue": {"congestion_control":'
+        ' {"drop": {"wait_before_drop": 1000000}}}}}}}'
+    )
     config = Config.model_validate(
         {
             "zenoh": {
@@ -107,6 +117,7 @@ def test_a_zenoh_subscriber_receives_support_and_the_state_carries_it() -> None:
                 "mode": "client",
                 "connect": [endpoint(port)],
                 "listen": [],
+                "config_file": str(patient),
             }
         }
     )

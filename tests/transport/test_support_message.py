@@ -143,8 +143,10 @@ def test_a_zenoh_subscriber_receives_support_and_the_state_carries_it(tmp_path: 
             publisher = BusPublisher(keys.vehicle_id, link)
             pipeline = Pipeline.from_config(config, ScriptedDetector([40.0] * 5))
             pipeline.run(ListSource(5), [health, publisher])
-            assert wait_for(lambda: len(received) >= 5, timeout_s=10.0)
-            assert link.status().support_sent == 5
+            arrived = wait_for(lambda: len(received) >= 5, timeout_s=10.0)
+            status = link.status()
+            assert arrived, (len(received), status.support_sent, status.support_not_sent)
+            assert status.support_sent == 5
             with client(port) as asker:
                 replies = list(asker.get(keys.state, timeout=5.0))
         subscriber.undeclare()

@@ -102,8 +102,8 @@ def test_without_a_verdict_support_is_heightened() -> None:
 def test_a_zenoh_subscriber_receives_support_and_the_state_carries_it(tmp_path: Path) -> None:
     """Support is put with congestion control DROP: Zenoh drops a message its queue cannot take
     within `wait_before_drop` (1 ms by default), which a loaded CI machine once reached (fewer
-    than 5 frames arrived in 10 s). The daemon accepts that (the next frame says it again); this test checks
-    the routing, so its session waits up to 1 s instead."""
+    than 5 frames arrived in 10 s). The daemon accepts that (the next frame says it again); this
+    test checks the routing, so its session waits up to 1 s instead."""
     port = free_port()
     patient = tmp_path / "zenoh.json5"
     patient.write_text(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import subprocess
 import sys
 import time
@@ -254,15 +255,20 @@ def test_speed_input_from_zenoh() -> None:
         assert speed.current() == (12.0, "fresh")
 
 
-def test_unreachable_router_degrades_then_recovers_and_delivers_kept_alerts() -> None:
+def test_unreachable_router_degrades_then_recovers_and_delivers_kept_alerts(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
     port = free_port()
     config = link_config(port, mode="client")
     keys = Keys.from_config(config)
-    link = ZenohLink(config, keys)
+    link = ZenohLink(config, keys, state_reply=lambda: b"{}")
     try:
         link.start()  # nothing listens on the port: must not raise
         status = link.status()
         assert not status.session_open and not status.connected
+        with caplog.at_level(logging.WARNING, logger="roadgaze.transport.link"):
+            link.publish_final_state()  # no session to put it on: said, not silently skipped
+        assert "final state not published: no zenoh session" in caplog.text
         link.publish_yaw(yaw_message(0))
         link.publish_alert(alert_message(0))
         assert link.status().pending_alerts == 1 and link.status().not_sent == 1

@@ -347,7 +347,10 @@ class ZenohLink:
         the service's last word, put just before the session closes: like an alert it goes out
         at once (express, REAL_TIME), not in a batch behind the frames' data."""
         declared = self._declared
-        if self.state_reply is None or declared is None:
+        if self.state_reply is None:
+            return
+        if declared is None:
+            log.warning("final state not published: no zenoh session")
             return
         import zenoh
 

@@ -278,10 +278,13 @@ def test_daemon_sigterm_publishes_final_state_and_its_token_goes_away(
     assert code == 0, stderr[-2000:]
     assert wait_for(lambda: recorder.alive == [True, False], timeout_s=5.0)
     # The token's DELETE and the final state travel apart: either may come first.
-    assert wait_for(lambda: any(s["status"] == "stopped" for s in recorder.of("state")), 5.0)
+    stopped = wait_for(lambda: any(s["status"] == "stopped" for s in recorder.of("state")), 10.0)
+    assert stopped, ([s["status"] for s in recorder.of("state")], stderr[-3000:])
     final = recorder.of("state")[-1]
     assert final["status"] == "stopped"
-    assert final["frames"] == len(recorder.of("yaw"))  # the final state counts every frame sent
+    # The final state counts every frame sent; yaw goes with congestion control DROP, so a loaded
+    # machine may receive fewer than were sent, never more.
+    assert final["transport"]["yaw_sent"] == final["frames"] >= len(recorder.of("yaw")) >= 15
     logs = [json.loads(line) for line in stderr.splitlines() if line.startswith("{")]
     assert any("SIGTERM received" in entry["message"] for entry in logs)
 

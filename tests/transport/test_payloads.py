@@ -112,8 +112,12 @@ def test_speed_is_read_from_a_ring_once_per_frame_and_oversize_payloads_are_not_
     speed.attach(lambda: ring.pop() if ring else None)
     assert speed.kmh() is None
     assert (speed.oversize, Payload.copies) == (1, 0)
+    assert speed.current() == (None, "invalid")  # not a speed: unknown at once, said so
     ring.append(Payload(b"55"))
     assert speed.kmh() == 55.0 and speed.messages == 2
+    ring.append(Payload(b"x" * 257))  # after a valid speed too: not kept until it is stale
+    assert speed.kmh() is None and speed.current() == (None, "invalid")
+    assert (speed.oversize, speed.rejected) == (2, 0)
 
 
 def test_checker_accepts_valid_messages_and_follows_alert_sequences() -> None:

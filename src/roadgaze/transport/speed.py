@@ -79,7 +79,8 @@ class SpeedInput:
 
     Payloads come from `attach(receive)` (the link's ring of one, read once per frame) or are
     pushed with `on_payload` (tests, other transports); only the newest is parsed. Counters:
-    `messages` (payloads taken), `oversize` (dropped unread), `rejected` (not a valid speed).
+    `messages` (payloads taken), `oversize` (dropped unread), `rejected` (not a valid speed);
+    either of the last two makes the speed unknown at once ("invalid").
     """
 
     def __init__(self, timeout_s: float = 2.0, clock: Callable[[], float] = time.monotonic) -> None:
@@ -114,9 +115,14 @@ class SpeedInput:
                 self.messages += 1
             return raw
         self.messages += 1
-        if len(payload) > SPEED_MAX_BYTES:
+        if len(payload) > SPEED_MAX_BYTES:  # not a speed either: unknown at once, as rejected
             self.oversize += 1
-            self._warn(f"{len(payload)} bytes, limit {SPEED_MAX_BYTES}: dropped unread")
+            self._warn(
+                f"{len(payload)} bytes, limit {SPEED_MAX_BYTES}: dropped unread; speed unknown "
+                "(taken as moving) until a valid one"
+            )
+            with self._lock:
+                self._invalid = True
             return None
         return payload.to_bytes()
 

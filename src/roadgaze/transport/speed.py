@@ -115,16 +115,17 @@ class SpeedInput:
                 self.messages += 1
             return raw
         self.messages += 1
-        if len(payload) > SPEED_MAX_BYTES:  # not a speed either: unknown at once, as rejected
+        if len(payload) > SPEED_MAX_BYTES:
             self.oversize += 1
-            self._warn(
-                f"{len(payload)} bytes, limit {SPEED_MAX_BYTES}: dropped unread; speed unknown "
-                "(taken as moving) until a valid one"
-            )
-            with self._lock:
-                self._invalid = True
+            self._not_a_speed(f"{len(payload)} bytes, limit {SPEED_MAX_BYTES}: dropped unread")
             return None
         return payload.to_bytes()
+
+    def _not_a_speed(self, why: str) -> None:
+        """A payload that is not a speed (oversize or rejected): the speed is unknown at once."""
+        self._warn(f"{why}; speed unknown (taken as moving) until a valid one")
+        with self._lock:
+            self._invalid = True
 
     def kmh(self) -> float | None:
         """The speed for this frame, in km/h; None when unknown (taken as moving)."""
@@ -134,9 +135,7 @@ class SpeedInput:
                 speed = parse_speed_kmh(raw)
             except PayloadError as exc:
                 self.rejected += 1
-                self._warn(f"{exc}; speed unknown (taken as moving) until a valid one")
-                with self._lock:
-                    self._invalid = True
+                self._not_a_speed(str(exc))
             else:
                 with self._lock:
                     self._speed_kmh, self._valid_at, self._invalid = speed, self._clock(), False
